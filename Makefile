@@ -1,0 +1,48 @@
+# The two commands of the README: `make demo` and `make test`. Both set up
+# what they need first (`make setup`), idempotently.
+SHELL := /bin/bash
+VENV := .venv
+WS := .ws
+PYTHON := $(CURDIR)/$(VENV)/bin/python3
+IN_ROS := source setup.bash &&
+
+.PHONY: setup apt demo test unit integration lint bench soak clean
+
+setup: apt $(VENV)/.ready $(WS)/devel/.ready
+
+apt:
+	@tools/install_apt.sh
+
+$(VENV)/.ready: tools/requirements.txt
+	/usr/bin/python3 -m venv --system-site-packages $(VENV)
+	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r tools/requirements.txt
+	touch $@
+
+# catkin_make again whenever what it generates from could have changed.
+$(WS)/devel/.ready: CMakeLists.txt package.xml setup.py env-hooks/* $(wildcard scripts/*) $(wildcard test/*.test) | $(VENV)/.ready
+	mkdir -p $(WS)/src
+	ln -sfn ../.. $(WS)/src/tb3_sim_nav
+	cd $(WS) && catkin_make -DPYTHON_EXECUTABLE=$(PYTHON) -DCATKIN_ENABLE_TESTING=ON > build.log 2>&1 \
+	  || { tail -40 build.log; exit 1; }
+	touch $@
+
+demo: setup
+	$(IN_ROS) python3 tools/demo.py
+
+test: setup
+	$(IN_ROS) tools/run_tests.sh
+
+unit: setup
+	$(IN_ROS) python3 -m pytest -q test/unit
+
+integration: setup
+	$(IN_ROS) tools/run_tests.sh --integration-only
+
+lint: setup
+	$(IN_ROS) catkin_lint --strict -W2 .
+
+bench: setup
+	$(IN_ROS) python3 tools/bench.py
+
+clean:
+	rm -rf $(WS) $(VENV)
