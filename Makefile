@@ -11,17 +11,22 @@ IN_ROS := source setup.bash &&
 setup: apt $(VENV)/.ready $(WS)/devel/.ready
 
 apt:
-	@tools/install_apt.sh
+	@bash tools/install_apt.sh
 
 $(VENV)/.ready: tools/requirements.txt
 	/usr/bin/python3 -m venv --system-site-packages $(VENV)
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r tools/requirements.txt
 	touch $@
 
+# The workspace's copy of the package is a folder of links to the repo's
+# top-level entries, not one link to the repo: rosrun searches the package
+# folder with `find -L`, which would loop through $(WS) and crawl $(VENV).
 # catkin_make again whenever what it generates from could have changed.
 $(WS)/devel/.ready: CMakeLists.txt package.xml setup.py env-hooks/* $(wildcard scripts/*) $(wildcard test/*.test) | $(VENV)/.ready
-	mkdir -p $(WS)/src
-	ln -sfn ../.. $(WS)/src/tb3_sim_nav
+	[ ! -L $(WS)/src/tb3_sim_nav ] || rm $(WS)/src/tb3_sim_nav
+	mkdir -p $(WS)/src/tb3_sim_nav
+	find $(WS)/src/tb3_sim_nav -maxdepth 1 -type l -delete
+	for entry in *; do ln -s "$(CURDIR)/$$entry" "$(WS)/src/tb3_sim_nav/$$entry"; done
 	cd $(WS) && catkin_make -DPYTHON_EXECUTABLE=$(PYTHON) -DCATKIN_ENABLE_TESTING=ON > build.log 2>&1 \
 	  || { tail -40 build.log; exit 1; }
 	touch $@
@@ -30,13 +35,13 @@ demo: setup
 	$(IN_ROS) python3 tools/demo.py
 
 test: setup
-	$(IN_ROS) tools/run_tests.sh
+	$(IN_ROS) bash tools/run_tests.sh
 
 unit: setup
 	$(IN_ROS) python3 -m pytest -q test/unit
 
 integration: setup
-	$(IN_ROS) tools/run_tests.sh --integration-only
+	$(IN_ROS) bash tools/run_tests.sh --integration-only
 
 lint: setup
 	$(IN_ROS) catkin_lint --strict -W2 .

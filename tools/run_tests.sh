@@ -1,0 +1,30 @@
+# make test (run with bash, inside `source setup.bash`): the unit tests
+# (pytest, no master), catkin_lint, then each integration test with rostest,
+# which starts its own master on a free port. Exit status: 0 only if all pass.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+export ROS_HOSTNAME=localhost
+unset ROS_IP
+failures=()
+
+if [ "${1:-}" != --integration-only ]; then
+  echo "== unit tests (pytest, no master)"
+  python3 -m pytest -q -p no:cacheprovider test/unit || failures+=(unit)
+  echo "== catkin_lint"
+  lint=$(catkin_lint --strict -W2 "$(rospack find tb3_sim_nav)" 2>&1)
+  echo "$lint"
+  echo "$lint" | grep -qE ': (error|warning|notice):' && failures+=(catkin_lint)
+fi
+
+for test_file in test/*.test; do
+  name=$(basename "$test_file")
+  echo "== rostest tb3_sim_nav $name"
+  # SIGINT first: rostest then stops every node it started.
+  timeout --signal=INT --kill-after=20 600 rostest --text tb3_sim_nav "$name" || failures+=("$name")
+done
+
+if [ ${#failures[@]} -gt 0 ]; then
+  echo "FAILED: ${failures[*]}"
+  exit 1
+fi
+echo "ALL PASSED"
