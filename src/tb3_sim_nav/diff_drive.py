@@ -57,9 +57,15 @@ def yaw_to_quaternion(yaw):
     return 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)
 
 
+def wrap_angle(angle):
+    """`angle` (rad) in (-pi, pi]."""
+    wrapped = math.atan2(math.sin(angle), math.cos(angle))
+    return math.pi if wrapped == -math.pi else wrapped
+
+
 def quaternion_to_yaw(x, y, z, w):
     """Rotation about z of a quaternion (x, y, z, w), in (-pi, pi]."""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    return wrap_angle(math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
 
 
 class EncoderOdometry(object):
@@ -87,6 +93,6 @@ class EncoderOdometry(object):
             heading = self.yaw + turn / 2.0
             self.x += distance * math.cos(heading)
             self.y += distance * math.sin(heading)
-            self.yaw = math.atan2(math.sin(self.yaw + turn), math.cos(self.yaw + turn))
+            self.yaw = wrap_angle(self.yaw + turn)
         self._last_angles = (left_angle, right_angle)
         return self.x, self.y, self.yaw

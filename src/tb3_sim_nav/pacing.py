@@ -29,6 +29,10 @@ class Pacer(object):
 
     def resume(self):
         self.paused = False
+        self.restart()
+
+    def restart(self):
+        """Pace from the next step on as if starting afresh (after a pause or hold)."""
         self._anchor = None
 
     def set_factor(self, factor):
@@ -61,9 +65,11 @@ class Schedule(object):
         self.next_ns = 0
 
     def due(self, now_ns):
+        if now_ns < self.next_ns - self.period_ns:  # time went back (a reset): start again
+            self.next_ns = now_ns
         if now_ns < self.next_ns:
             return False
         self.next_ns += self.period_ns
-        if self.next_ns <= now_ns:  # time jumped (a reset): restart the grid from now
+        if self.next_ns <= now_ns:  # time jumped ahead: restart the grid from now
             self.next_ns = now_ns + self.period_ns
         return True

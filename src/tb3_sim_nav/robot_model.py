@@ -61,7 +61,12 @@ def read_drive_geometry(urdf_path):
             raise ModelError('URDF file %r has no joint %r' % (urdf_path, name))
         origin = joint.find('origin')
         origins.append(_floats(origin.get('xyz', '0 0 0')) if origin is not None else [0.0] * 3)
-        geometry = links[joint.find('child').get('link')].find('collision/geometry')
+        child = joint.find('child')
+        link = links.get(child.get('link') if child is not None else None)
+        if link is None:
+            raise ModelError('URDF file %r: joint %r has no child link defined in the file'
+                             % (urdf_path, name))
+        geometry = link.find('collision/geometry')
         round_shape = None if geometry is None else (
             geometry.find('sphere') if geometry.find('sphere') is not None else geometry.find('cylinder'))
         if round_shape is None:

@@ -1,0 +1,96 @@
+"""Parameter validation: defaults, types and ranges, with messages naming name and value."""
+import math
+
+import pytest
+
+from tb3_sim_nav.params import PARAMETERS, ParameterError, resolve
+
+
+@pytest.fixture
+def resolve_with(burger_urdf):
+    """resolve() with a dict standing in for rospy.get_param('~name', default)."""
+    def run(**given):
+        values = dict(urdf_file=str(burger_urdf))
+        values.update(given)
+        return resolve(lambda name, default: values.get(name, default))
+    return run
+
+
+def test_defaults_resolve(resolve_with, burger_urdf):
+    config = resolve_with()
+    assert list(config) == [parameter.name for parameter in PARAMETERS]
+    for parameter in PARAMETERS:
+        expected = str(burger_urdf) if parameter.name == 'urdf_file' else parameter.default
+        assert config[parameter.name] == expected
+        assert type(config[parameter.name]) is parameter.kind
+    assert config['real_time_factor'] == 1.0 and config['physics_rate'] == 200.0
+    assert config['odom_frame'] == 'odom' and config['base_frame'] == 'base_footprint'
+
+
+def test_ints_are_accepted_for_floats(resolve_with):
+    config = resolve_with(physics_rate=100, odom_rate=30, x_pos=-2, real_time_factor=0)
+    assert config['physics_rate'] == 100.0 and type(config['physics_rate']) is float
+    assert config['x_pos'] == -2.0 and type(config['x_pos']) is float
+    assert config['real_time_factor'] == 0.0 and type(config['real_time_factor']) is float
+
+
+@pytest.mark.parametrize('name, value, shown', [
+    # wrong types
+    ('real_time_factor', '1.0', "'1.0'"),
+    ('x_pos', 'zero', "'zero'"),
+    ('gui', 1.0, '1.0'),
+    ('paused', 0, '0'),
+    ('yaw', True, 'True'),
+    ('physics_rate', False, 'False'),
+    ('odom_frame', 5, '5'),
+    ('urdf_file', None, 'None'),
+    # non-finite floats
+    ('x_pos', math.nan, 'nan'),
+    ('max_linear_speed', math.inf, 'inf'),
+    ('yaw', -math.inf, '-inf'),
+    # out of range
+    ('real_time_factor', -1.0, '-1.0'),
+    ('real_time_factor', -0.5, '-0.5'),
+    ('physics_rate', 0.0, '0.0'),
+    ('physics_rate', -200.0, '-200.0'),
+    ('odom_rate', 0.0, '0.0'),
+    ('joint_states_rate', -30.0, '-30.0'),
+    ('max_angular_speed', 0.0, '0.0'),
+    ('wheel_torque', -1.5, '-1.5'),
+    ('odom_rate', 300.0, '300.0'),  # above physics_rate
+    # frames
+    ('odom_frame', '/odom', "'/odom'"),
+    ('base_frame', '/base_footprint', "'/base_footprint'"),
+    ('base_frame', '', "''"),
+    ('odom_frame', '', "''"),
+])
+def test_bad_value_raises_error_naming_parameter_and_value(resolve_with, name, value, shown):
+    with pytest.raises(ParameterError) as error:
+        resolve_with(**{name: value})
+    message = str(error.value)
+    assert '~' + name in message
+    assert shown in message
+
+
+def test_odom_rate_above_physics_rate_names_both(resolve_with):
+    with pytest.raises(ParameterError) as error:
+        resolve_with(physics_rate=100.0, odom_rate=150.0)
+    message = str(error.value)
+    assert '~odom_rate' in message and '150.0' in message
+    assert '~physics_rate' in message and '100.0' in message
+
+
+def test_odom_rate_equal_to_physics_rate_is_fine(resolve_with):
+    assert resolve_with(physics_rate=100.0, odom_rate=100.0)['odom_rate'] == 100.0
+
+
+@pytest.mark.parametrize('path', ['', 'no/such/robot.urdf'])
+def test_missing_urdf_file_raises_error_naming_it(resolve_with, path):
+    with pytest.raises(ParameterError) as error:
+        resolve_with(urdf_file=path)
+    assert '~urdf_file' in str(error.value) and repr(path) in str(error.value)
+
+
+def test_urdf_file_not_given_at_all_raises():
+    with pytest.raises(ParameterError, match='~urdf_file'):
+        resolve(lambda name, default: default)
