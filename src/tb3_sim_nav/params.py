@@ -3,12 +3,15 @@
 `resolve(lookup)` reads each parameter once through `lookup(name, default)`
 (rospy.get_param on '~name' in the node, a dict in tests) and returns them
 checked, or raises ParameterError naming the parameter and the value.
+
+A realism profile (`~profile`) only chooses defaults: every knob it sets is
+a parameter of its own, and a value given explicitly wins.
 """
 import math
 import os
 from collections import OrderedDict, namedtuple
 
-Parameter = namedtuple('Parameter', 'name default kind check doc')
+Parameter = namedtuple('Parameter', 'name default kind check unit doc')
 
 
 class ParameterError(ValueError):
@@ -21,6 +24,10 @@ def _positive(value):
 
 def _non_negative(value):
     return None if value >= 0 else 'must be >= 0'
+
+
+def _fraction(value):
+    return None if -0.5 < value < 0.5 else 'must be between -0.5 and 0.5'
 
 
 def _existing_file(value):
@@ -37,52 +44,104 @@ def _frame_id(value):
 
 def _one_of(*choices):
     def check(value):
-        return None if value in choices else 'must be one of %s' % ', '.join(choices)
+        return None if value in choices else 'must be one of: %s' % ', '.join(choices)
     return check
 
 
+def _at_least(minimum):
+    def check(value):
+        return None if value >= minimum else 'must be >= %s' % minimum
+    return check
+
+
+#: The defaults each profile gives its knobs. 'gazebo' is TurtleBot3's
+#: Gazebo set-up: perfect odometry, no slip, commands held forever;
+#: 'realistic' is closer to a real Burger on a floor.
+PROFILES = {
+    'gazebo': dict(odom_source='world', ground_friction=1.0, caster_friction=0.0,
+                   odom_wheel_radius_error=0.0, odom_wheel_separation_error=0.0,
+                   encoder_noise=0.0, max_wheel_acceleration=0.0, cmd_vel_timeout=0.0,
+                   imu_gyro_noise=2e-4, imu_accel_noise=1.7e-2),
+    'realistic': dict(odom_source='encoders', ground_friction=0.8, caster_friction=0.3,
+                      odom_wheel_radius_error=0.01, odom_wheel_separation_error=-0.04,
+                      encoder_noise=0.002, max_wheel_acceleration=30.0, cmd_vel_timeout=0.5,
+                      imu_gyro_noise=2e-3, imu_accel_noise=5e-2),
+}
+
 PARAMETERS = [
-    Parameter('urdf_file', '', str, _existing_file, 'URDF of the robot, loaded into pybullet; wheel geometry comes from it'),
-    Parameter('x_pos', 0.0, float, None, 'spawn position x in odom (m)'),
-    Parameter('y_pos', 0.0, float, None, 'spawn position y in odom (m)'),
-    Parameter('z_pos', 0.0, float, None, 'spawn height of base_footprint (m)'),
-    Parameter('yaw', 0.0, float, None, 'spawn heading (rad)'),
-    Parameter('gui', False, bool, None, "open pybullet's own window (needs a display)"),
-    Parameter('real_time_factor', 1.0, float, _non_negative, 'simulated seconds per wall second; 0 = as fast as possible'),
-    Parameter('paused', False, bool, None, 'start with physics paused (unpause_physics service resumes)'),
-    Parameter('physics_rate', 200.0, float, _positive, 'physics steps per simulated second (Hz); /clock is published every step'),
-    Parameter('odom_rate', 30.0, float, _positive, 'rate of odom, tf and base_pose_ground_truth (Hz, sim time)'),
-    Parameter('joint_states_rate', 30.0, float, _positive, 'rate of joint_states (Hz, sim time)'),
-    Parameter('max_linear_speed', 0.22, float, _positive, 'commands beyond this are clamped (m/s)'),
-    Parameter('max_angular_speed', 2.84, float, _positive, 'commands beyond this are clamped (rad/s)'),
-    Parameter('wheel_torque', 1.5, float, _positive, 'stall torque of each wheel motor (N m, Dynamixel XL430 at 12 V)'),
-    Parameter('odom_frame', 'odom', str, _frame_id, 'frame of odom and of its tf parent'),
-    Parameter('base_frame', 'base_footprint', str, _frame_id, 'child frame of odom and its tf'),
+    Parameter('urdf_file', '', str, _existing_file, '', 'URDF of the robot, loaded into pybullet; wheel geometry comes from it'),
+    Parameter('world', 'empty', str, None, '', 'world by name (worlds/NAME.yaml) or path to a world file'),
+    Parameter('x_pos', 0.0, float, None, 'm', 'spawn position x'),
+    Parameter('y_pos', 0.0, float, None, 'm', 'spawn position y'),
+    Parameter('z_pos', 0.0, float, None, 'm', 'spawn height of base_footprint'),
+    Parameter('yaw', 0.0, float, None, 'rad', 'spawn heading'),
+    Parameter('gui', False, bool, None, '', "open pybullet's own window (needs a display)"),
+    Parameter('real_time_factor', 1.0, float, _non_negative, '', 'simulated seconds per wall second; 0 = as fast as possible'),
+    Parameter('paused', False, bool, None, '', 'start with physics paused (/gazebo/unpause_physics resumes)'),
+    Parameter('physics_rate', 200.0, float, _positive, 'Hz', 'physics steps per simulated second; /clock is published every step'),
+    Parameter('max_clock_lead', 0.01, float, _non_negative, 's', 'how far /clock may run ahead of what a python subscriber has received'),
+    Parameter('startup_hold', 0.5, float, _non_negative, 's (wall)', 'sim time holds this long when a node subscribes to /clock, so it can connect first'),
+    Parameter('odom_rate', 30.0, float, _positive, 'Hz', 'rate of odom, tf and base_pose_ground_truth (sim time)'),
+    Parameter('joint_states_rate', 30.0, float, _positive, 'Hz', 'rate of joint_states (sim time)'),
+    Parameter('max_linear_speed', 0.22, float, _positive, 'm/s', 'commands beyond this are clamped'),
+    Parameter('max_angular_speed', 2.84, float, _positive, 'rad/s', 'commands beyond this are clamped'),
+    Parameter('wheel_torque', 1.5, float, _positive, 'N m', 'stall torque of each wheel motor (Dynamixel XL430 at 12 V)'),
+    Parameter('odom_frame', 'odom', str, _frame_id, '', 'frame of odom and of its tf parent'),
+    Parameter('base_frame', 'base_footprint', str, _frame_id, '', 'child frame of odom and its tf'),
+    Parameter('scan', True, bool, None, '', 'publish the LDS-01 lidar on scan'),
+    Parameter('scan_rate', 5.0, float, _positive, 'Hz', 'scan rate (sim time)'),
+    Parameter('scan_samples', 360, int, _at_least(3), '', 'beams per turn'),
+    Parameter('scan_range_min', 0.12, float, _non_negative, 'm', 'closer hits read -inf'),
+    Parameter('scan_range_max', 3.5, float, _positive, 'm', 'beams reaching no wall within it read +inf'),
+    Parameter('scan_noise', 0.01, float, _non_negative, 'm', 'standard deviation of Gaussian range noise; 0 = none'),
+    Parameter('imu', True, bool, None, '', 'publish the IMU on imu'),
+    Parameter('imu_rate', 200.0, float, _positive, 'Hz', 'IMU rate (sim time; the real Burger: 200 Hz)'),
+    Parameter('seed', -1, int, _at_least(-1), '', 'seed of every noise source; -1 = different each run'),
+    Parameter('profile', 'gazebo', str, _one_of(*sorted(PROFILES)), '', 'realism profile: chooses the defaults below'),
+    Parameter('odom_source', None, str, _one_of('world', 'encoders'), '', 'odom from the true pose (Gazebo) or integrated from wheel encoders (firmware)'),
+    Parameter('ground_friction', None, float, _positive, '', 'Coulomb friction of wheel on ground'),
+    Parameter('caster_friction', None, float, _non_negative, '', 'Coulomb friction of the ball caster on ground (drags when turning)'),
+    Parameter('odom_wheel_radius_error', None, float, _fraction, 'fraction', 'encoder odometry assumes a wheel this much bigger than the real one'),
+    Parameter('odom_wheel_separation_error', None, float, _fraction, 'fraction', 'encoder odometry assumes wheels this much further apart than they act'),
+    Parameter('encoder_noise', None, float, _non_negative, 'rad', 'standard deviation of Gaussian noise on each wheel-angle reading'),
+    Parameter('max_wheel_acceleration', None, float, _non_negative, 'rad/s^2', 'motor acceleration limit; 0 = none'),
+    Parameter('cmd_vel_timeout', None, float, _non_negative, 's', 'stop when no cmd_vel came for this long (firmware: 0.5); 0 = hold the last command forever'),
+    Parameter('imu_gyro_noise', None, float, _non_negative, 'rad/s', 'standard deviation of angular-velocity noise'),
+    Parameter('imu_accel_noise', None, float, _non_negative, 'm/s^2', 'standard deviation of linear-acceleration noise'),
 ]
 
 
 def _typed(parameter, value):
     """`value` as the parameter's type, or ParameterError."""
     kind = parameter.kind
-    if kind is float and isinstance(value, (int, float)) and not isinstance(value, bool):
-        if math.isfinite(value):
-            return float(value)
-    elif isinstance(value, kind):
+    if isinstance(value, bool) != (kind is bool):
+        pass  # a bool is an int in python, but never a number here
+    elif kind is float and isinstance(value, (int, float)) and math.isfinite(value):
+        return float(value)
+    elif kind is not float and isinstance(value, kind):
         return value
-    raise ParameterError('parameter ~%s = %r (%s): must be a finite %s'
-                         % (parameter.name, value, type(value).__name__, kind.__name__))
+    raise ParameterError('parameter ~%s = %r (%s): must be a%s %s'
+                         % (parameter.name, value, type(value).__name__,
+                            ' finite' if kind is float else '', kind.__name__))
 
 
 def resolve(lookup, parameters=PARAMETERS):
     """Every parameter, checked: an OrderedDict name -> value."""
     resolved = OrderedDict()
     for parameter in parameters:
-        value = _typed(parameter, lookup(parameter.name, parameter.default))
+        default = parameter.default
+        if default is None:  # a knob of the realism profile
+            default = PROFILES[resolved['profile']][parameter.name]
+        value = _typed(parameter, lookup(parameter.name, default))
         problem = parameter.check(value) if parameter.check else None
         if problem:
             raise ParameterError('parameter ~%s = %r: %s' % (parameter.name, value, problem))
         resolved[parameter.name] = value
-    if resolved['odom_rate'] > resolved['physics_rate']:
-        raise ParameterError('parameter ~odom_rate = %r: must not exceed ~physics_rate = %r'
-                             % (resolved['odom_rate'], resolved['physics_rate']))
+    for rate in ('odom_rate', 'joint_states_rate', 'scan_rate', 'imu_rate'):
+        if resolved[rate] > resolved['physics_rate']:
+            raise ParameterError('parameter ~%s = %r: must not exceed ~physics_rate = %r'
+                                 % (rate, resolved[rate], resolved['physics_rate']))
+    if resolved['scan_range_min'] >= resolved['scan_range_max']:
+        raise ParameterError('parameter ~scan_range_min = %r: must be below ~scan_range_max = %r'
+                             % (resolved['scan_range_min'], resolved['scan_range_max']))
     return resolved

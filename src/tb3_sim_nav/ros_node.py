@@ -1,67 +1,97 @@
-"""The ROS edge: parameters in, topics and services around a SimWorld.
+"""The ROS edge: parameters in, topics and services around a Simulation.
 
 The only module of the package that imports rospy. One physics step gives
 one timestamp to everything it publishes.
 """
+import os
 import sys
+import threading
 import time
 
+import rospkg
 import rospy
 from geometry_msgs.msg import TransformStamped, Twist
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import Imu, JointState, LaserScan
 from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
 
 from . import params
-from .diff_drive import Limits, sanitize_twist, wheel_speeds
+from .diff_drive import Limits, sanitize_twist
 from .pacing import Pacer, Schedule
 from .robot_model import LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT, ModelError, read_drive_geometry
+from .world_file import WorldError, load_world
 
-WARN_PERIOD = 5.0  # s between repeats of the same warning
-PAUSED_POLL = 0.01  # wall s between checks while paused
+WARN_PERIOD = 5.0    # s between repeats of the same warning
+IDLE_POLL = 0.01     # wall s between checks while paused or holding
+ECHO_TIMEOUT = 0.05  # wall s to wait for our own /clock before stepping on regardless
 # Diagonal covariances of odom, as Gazebo's diff-drive plugin fills them:
 # x, y and yaw are known well; z, roll and pitch are not estimated at all.
-COVARIANCE_DIAGONAL = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
+ODOM_COVARIANCE = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
 
 
 def _diagonal(values):
-    matrix = [0.0] * 36
+    matrix = [0.0] * (len(values) ** 2)
     for index, value in enumerate(values):
-        matrix[index * 7] = value
+        matrix[index * (len(values) + 1)] = value
     return matrix
 
 
-class SimulatorNode(object):
-    """Steps the world in sim time and publishes what Gazebo's TurtleBot3 does."""
+def _set_xyz(vector, values):
+    vector.x, vector.y, vector.z = values
 
-    def __init__(self, config, geometry):
-        from .world import SimWorld  # imports pybullet: after the parameters are known good
+
+def _set_quaternion(quaternion, values):
+    quaternion.x, quaternion.y, quaternion.z, quaternion.w = values
+
+
+class _OnSubscribe(rospy.SubscribeListener):
+    def __init__(self, callback):
+        super(_OnSubscribe, self).__init__()
+        self._callback = callback
+
+    def peer_subscribe(self, topic_name, topic_publish, peer_publish):
+        self._callback()
+
+
+class SimulatorNode(object):
+    """Steps the simulation in sim time and publishes what Gazebo's TurtleBot3 does."""
+
+    def __init__(self, config, simulation):
         self.config = config
-        self.geometry = geometry
+        self.sim = simulation
         self.limits = Limits(config['max_linear_speed'], config['max_angular_speed'])
-        self.step_ns = int(round(1e9 / config['physics_rate']))
-        self.world = SimWorld(config['urdf_file'],
-                              (config['x_pos'], config['y_pos'], config['z_pos'], config['yaw']),
-                              time_step=self.step_ns * 1e-9, wheel_torque=config['wheel_torque'],
-                              gui=config['gui'])
         self.pacer = Pacer(config['real_time_factor'], paused=config['paused'])
-        self.steps = 0
-        self._command = (0.0, 0.0)
-        self._applied = None
-        self._odom_due = Schedule(round(1e9 / config['odom_rate']))
-        self._joints_due = Schedule(round(1e9 / config['joint_states_rate']))
-        self._clock = Clock()
+        self._lock = threading.Lock()  # steps versus reset services
+        self._command = (0.0, 0.0, 0)  # v, w, count of commands received
+        self._applied_count = 0
+        self._hold_until = 0.0
+        self._echo_ns = 0
+        self._echo = threading.Condition()
+        self._max_lead_ns = int(round(config['max_clock_lead'] * 1e9))
+        self._make_schedules()
         self._make_messages()
-        self.clock_pub = rospy.Publisher('clock', Clock, queue_size=10)
-        self.odom_pub = rospy.Publisher('odom', Odometry, queue_size=10)
-        self.truth_pub = rospy.Publisher('base_pose_ground_truth', Odometry, queue_size=10)
-        self.joints_pub = rospy.Publisher('joint_states', JointState, queue_size=10)
-        self.tf_pub = rospy.Publisher('tf', TFMessage, queue_size=100)
-        rospy.Subscriber('cmd_vel', Twist, self._on_cmd_vel, queue_size=10)
-        rospy.Service('gazebo/pause_physics', Empty, self._on_pause)
-        rospy.Service('gazebo/unpause_physics', Empty, self._on_unpause)
+        # Small messages at a high rate: no Nagle delays on loopback.
+        publish = dict(queue_size=10, tcp_nodelay=True)
+        self.clock_pub = rospy.Publisher('clock', Clock, subscriber_listener=_OnSubscribe(self._hold_clock),
+                                         **publish)
+        self.odom_pub = rospy.Publisher('odom', Odometry, **publish)
+        self.truth_pub = rospy.Publisher('base_pose_ground_truth', Odometry, **publish)
+        self.joints_pub = rospy.Publisher('joint_states', JointState, **publish)
+        self.tf_pub = rospy.Publisher('tf', TFMessage, queue_size=100, tcp_nodelay=True)
+        self.scan_pub = rospy.Publisher('scan', LaserScan, **publish) if simulation.lidar else None
+        self.imu_pub = rospy.Publisher('imu', Imu, **publish) if simulation.imu else None
+        rospy.Subscriber('cmd_vel', Twist, self._on_cmd_vel, queue_size=10, tcp_nodelay=True)
+        rospy.Subscriber('clock', Clock, self._on_clock_echo, queue_size=1, tcp_nodelay=True)
+        for name, handler in (('pause_physics', self._on_pause), ('unpause_physics', self._on_unpause),
+                              ('reset_world', self._on_reset_world),
+                              ('reset_simulation', self._on_reset_simulation)):
+            rospy.Service('gazebo/' + name, Empty, handler)
+
+    def _make_schedules(self):
+        self._due = dict((name, Schedule(round(1e9 / self.config[name + '_rate'])))
+                         for name in ('odom', 'joint_states', 'scan', 'imu'))
 
     def _make_messages(self):
         """Messages reused every publication: only stamps and values change."""
@@ -69,8 +99,8 @@ class SimulatorNode(object):
         self._odom = Odometry()
         self._odom.header.frame_id = frame
         self._odom.child_frame_id = child
-        self._odom.pose.covariance = _diagonal(COVARIANCE_DIAGONAL)
-        self._odom.twist.covariance = _diagonal(COVARIANCE_DIAGONAL)
+        self._odom.pose.covariance = _diagonal(ODOM_COVARIANCE)
+        self._odom.twist.covariance = _diagonal(ODOM_COVARIANCE)
         self._truth = Odometry()
         self._truth.header.frame_id = frame
         self._truth.child_frame_id = child
@@ -79,15 +109,57 @@ class SimulatorNode(object):
         self._transform.child_frame_id = child
         self._tf = TFMessage(transforms=[self._transform])
         self._joints = JointState(name=[LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT])
+        lidar = self.sim.lidar
+        if lidar:
+            self._scan = LaserScan(angle_min=0.0, angle_increment=lidar.angle_increment,
+                                   angle_max=lidar.angle_increment * (self.config['scan_samples'] - 1),
+                                   scan_time=1.0 / self.config['scan_rate'],
+                                   range_min=lidar.range_min, range_max=lidar.range_max)
+            self._scan.header.frame_id = 'base_scan'
+        if self.sim.imu:
+            self._imu = Imu()
+            self._imu.header.frame_id = 'imu_link'
+            gyro, accel = self.config['imu_gyro_noise'], self.config['imu_accel_noise']
+            # A zero covariance would claim a perfect sensor: keep a floor.
+            self._imu.orientation_covariance = _diagonal([1e-6] * 3)
+            self._imu.angular_velocity_covariance = _diagonal([max(gyro ** 2, 1e-8)] * 3)
+            self._imu.linear_acceleration_covariance = _diagonal([max(accel ** 2, 1e-6)] * 3)
 
-    # --- inputs -----------------------------------------------------------
+    # --- inputs -------------------------------------------------------------
     def _on_cmd_vel(self, twist):
         v, w, complaints = sanitize_twist((twist.linear.x, twist.linear.y, twist.linear.z),
                                           (twist.angular.x, twist.angular.y, twist.angular.z),
                                           self.limits)
         if complaints:
             rospy.logwarn_throttle(WARN_PERIOD, 'cmd_vel: ' + '; '.join(complaints))
-        self._command = (v, w)  # one atomic assignment; the step loop picks it up
+        self._command = (v, w, self._command[2] + 1)  # one assignment; the step loop picks it up
+
+    def _hold_clock(self):
+        """A node has subscribed to /clock: it is starting up. Hold time still
+        while it connects its other topics, so that its first commands are not
+        lost to connection set-up, which takes wall time, not sim time."""
+        self._hold_until = time.monotonic() + self.config['startup_hold']
+
+    def _on_clock_echo(self, message):
+        with self._echo:
+            self._echo_ns = message.clock.to_nsec()
+            self._echo.notify()
+
+    def _wait_for_echo(self, now_ns):
+        """Hold the next step until our own /clock subscriber has seen `now_ns - lead`.
+
+        Faster than real time, every other node lags behind /clock by its
+        delivery and processing time, and a command it sends arrives that much
+        sim time late. Waiting for a python subscriber of our own bounds that
+        lag in sim time whatever the factor.
+        """
+        deadline = time.monotonic() + ECHO_TIMEOUT
+        with self._echo:
+            while self._echo_ns < now_ns - self._max_lead_ns and not rospy.is_shutdown():
+                remaining = deadline - time.monotonic()
+                if remaining <= 0.0:
+                    return
+                self._echo.wait(remaining)
 
     def _on_pause(self, _request):
         self.pacer.pause()
@@ -97,75 +169,122 @@ class SimulatorNode(object):
         self.pacer.resume()
         return EmptyResponse()
 
+    def _on_reset_world(self, _request):
+        with self._lock:
+            self.sim.reset_world()
+        rospy.loginfo('reset_world: robot back at its spawn pose, odometry zeroed')
+        return EmptyResponse()
+
+    def _on_reset_simulation(self, _request):
+        with self._lock:
+            self.sim.reset_simulation()
+            with self._echo:
+                self._echo_ns = 0
+            self.pacer.restart()
+        rospy.loginfo('reset_simulation: robot back at its spawn pose, time back to zero')
+        return EmptyResponse()
+
     # --- the step loop ------------------------------------------------------
     def run(self):
         while not rospy.is_shutdown():
-            if self.pacer.paused:
-                time.sleep(PAUSED_POLL)
+            if self.pacer.paused or time.monotonic() < self._hold_until:
+                self.pacer.restart()
+                time.sleep(IDLE_POLL)
                 continue
-            self.pacer.wait_until((self.steps + 1) * self.step_ns * 1e-9)
-            self.step()
+            self.pacer.wait_until((self.sim.steps + 1) * self.sim.step_ns * 1e-9)
+            with self._lock:
+                self.step()
+            self._wait_for_echo(self.sim.now_ns)
 
     def step(self):
-        command = self._command
-        if command is not self._applied:
-            self.world.set_wheel_speeds(*wheel_speeds(command[0], command[1], *self.geometry))
-            self._applied = command
-        self.world.step()
-        self.steps += 1
-        now_ns = self.steps * self.step_ns
+        v, w, count = self._command
+        if count != self._applied_count:
+            self.sim.command(v, w)
+            self._applied_count = count
+        self.sim.step()
+        now_ns = self.sim.now_ns
         stamp = rospy.Time(now_ns // 1000000000, now_ns % 1000000000)
-        self._clock.clock = stamp
-        self.clock_pub.publish(self._clock)
-        if self._odom_due.due(now_ns):
+        self.clock_pub.publish(Clock(clock=stamp))
+        due = self._due
+        if due['odom'].due(now_ns):
             self.publish_odometry(stamp)
-        if self._joints_due.due(now_ns):
+        if due['joint_states'].due(now_ns):
             self.publish_joint_states(stamp)
+        if self.scan_pub and due['scan'].due(now_ns):
+            self.publish_scan(stamp)
+        if self.imu_pub and due['imu'].due(now_ns):
+            self.publish_imu(stamp)
 
     def publish_odometry(self, stamp):
-        position, orientation = self.world.base_pose()
-        linear, angular = self.world.base_twist()
-        for message in (self._odom, self._truth):
+        odom_pose = self.sim.odometry_pose()
+        for message, (position, orientation), (linear, angular) in (
+                (self._odom, odom_pose, self.sim.odometry_twist()),
+                (self._truth, self.sim.true_pose(), self.sim.true_twist())):
             message.header.stamp = stamp
-            pose = message.pose.pose
-            pose.position.x, pose.position.y, pose.position.z = position
-            (pose.orientation.x, pose.orientation.y,
-             pose.orientation.z, pose.orientation.w) = orientation
-            twist = message.twist.twist
-            twist.linear.x, twist.linear.y, twist.linear.z = linear
-            twist.angular.x, twist.angular.y, twist.angular.z = angular
-        transform = self._transform.transform
+            _set_xyz(message.pose.pose.position, position)
+            _set_quaternion(message.pose.pose.orientation, orientation)
+            _set_xyz(message.twist.twist.linear, linear)
+            _set_xyz(message.twist.twist.angular, angular)
         self._transform.header.stamp = stamp
-        transform.translation.x, transform.translation.y, transform.translation.z = position
-        transform.rotation = self._odom.pose.pose.orientation
+        _set_xyz(self._transform.transform.translation, odom_pose[0])
+        _set_quaternion(self._transform.transform.rotation, odom_pose[1])
         self.odom_pub.publish(self._odom)
         self.tf_pub.publish(self._tf)
         self.truth_pub.publish(self._truth)
 
     def publish_joint_states(self, stamp):
-        positions, velocities = self.world.wheel_states()
+        positions, velocities = self.sim.wheel_states()
         self._joints.header.stamp = stamp
         self._joints.position = positions
         self._joints.velocity = velocities
         self.joints_pub.publish(self._joints)
 
-    def close(self):
-        self.world.close()
+    def publish_scan(self, stamp):
+        self._scan.header.stamp = stamp
+        self._scan.ranges = self.sim.scan().tolist()
+        self.scan_pub.publish(self._scan)
+
+    def publish_imu(self, stamp):
+        reading = self.sim.imu_reading()
+        self._imu.header.stamp = stamp
+        _set_quaternion(self._imu.orientation, reading.orientation)
+        _set_xyz(self._imu.angular_velocity, reading.angular_velocity)
+        _set_xyz(self._imu.linear_acceleration, reading.linear_acceleration)
+        self.imu_pub.publish(self._imu)
+
+
+def _start_up():
+    """Parameters, URDF and world checked, or a fatal message and exit status 2."""
+    try:
+        from .simulation import Simulation
+    except ImportError as error:
+        rospy.logfatal('tb3_sim cannot start: %s. %s has no pybullet: run `make setup` and '
+                       '`source setup.bash`, or see the README on other workspaces', error, sys.executable)
+        sys.exit(2)
+    try:
+        config = params.resolve(lambda name, default: rospy.get_param('~' + name, default))
+        geometry = read_drive_geometry(config['urdf_file'])
+        worlds = os.path.join(rospkg.RosPack().get_path('tb3_sim_nav'), 'worlds')
+        obstacles = load_world(config['world'], worlds)
+        rospy.loginfo('tb3_sim parameters: %s', ', '.join('%s=%r' % item for item in config.items()))
+        rospy.loginfo('tb3_sim: wheel radius %.4f m and separation %.4f m from %s; world %r with %d obstacles',
+                      geometry.wheel_radius, geometry.wheel_separation, config['urdf_file'],
+                      config['world'], len(obstacles))
+        return config, Simulation(config, geometry, obstacles)
+    except (params.ParameterError, ModelError, WorldError, ValueError) as error:
+        rospy.logfatal('tb3_sim cannot start: %s', error)
+        rospy.signal_shutdown('bad start-up configuration')
+        sys.exit(2)
 
 
 def main():
     rospy.init_node('tb3_sim')
+    config, simulation = _start_up()
+    if config['real_time_factor'] == 0.0:
+        # As fast as possible, but only on CPU that no other node wants: a
+        # script starved of CPU would react late in sim time.
+        os.nice(10)
     try:
-        config = params.resolve(lambda name, default: rospy.get_param('~' + name, default))
-        geometry = read_drive_geometry(config['urdf_file'])
-    except (params.ParameterError, ModelError) as error:
-        rospy.logfatal('tb3_sim cannot start: %s', error)
-        sys.exit(2)
-    rospy.loginfo('tb3_sim parameters: %s', ', '.join('%s=%r' % item for item in config.items()))
-    rospy.loginfo('tb3_sim drive geometry from %s: wheel radius %.4f m, separation %.4f m',
-                  config['urdf_file'], geometry.wheel_radius, geometry.wheel_separation)
-    node = SimulatorNode(config, geometry)
-    try:
-        node.run()
+        SimulatorNode(config, simulation).run()
     finally:
-        node.close()
+        simulation.close()

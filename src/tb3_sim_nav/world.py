@@ -15,13 +15,15 @@ from .robot_model import LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT, urdf_for_pybullet
 GRAVITY = 9.81           # m/s^2
 GROUND_FRICTION = 1.0    # rubber tyre on a hard floor
 CASTER_LINK = 'caster_back_link'
+STATIC_BODIES = 2        # Bullet's collision group of bodies with mass 0
 
 
 class SimWorld(object):
     """A TurtleBot3 on a plane, in its own pybullet client."""
 
     def __init__(self, urdf_path, spawn_pose=(0.0, 0.0, 0.0, 0.0), time_step=1.0 / 200,
-                 wheel_torque=1.5, gui=False):
+                 wheel_torque=1.5, gui=False, obstacles=(), ground_friction=GROUND_FRICTION,
+                 caster_friction=0.0):
         self.time_step = time_step
         self.wheel_torque = wheel_torque
         self._spawn_pose = spawn_pose
@@ -34,17 +36,49 @@ class SimWorld(object):
         pybullet.setTimeStep(time_step, **self._call)
         plane_shape = pybullet.createCollisionShape(pybullet.GEOM_PLANE, **self._call)
         self.plane = pybullet.createMultiBody(0, plane_shape, **self._call)
-        pybullet.changeDynamics(self.plane, -1, lateralFriction=GROUND_FRICTION, **self._call)
+        pybullet.changeDynamics(self.plane, -1, lateralFriction=1.0, **self._call)
+        self.obstacles = [self._add_obstacle(obstacle) for obstacle in obstacles]
         self.robot = self._load_robot(urdf_path, spawn_pose)
         links = self._link_indices()
         self.wheels = [links[LEFT_WHEEL_JOINT], links[RIGHT_WHEEL_JOINT]]
+        # Bullet multiplies the two bodies' coefficients: the plane's is 1, so
+        # these are the coefficients of wheel and caster on the ground.
         for wheel in self.wheels:
-            pybullet.changeDynamics(self.robot, wheel, lateralFriction=GROUND_FRICTION,
+            pybullet.changeDynamics(self.robot, wheel, lateralFriction=ground_friction,
                                     rollingFriction=0.0, spinningFriction=0.0, **self._call)
-        # The ball caster carries weight but must never steer the robot.
-        pybullet.changeDynamics(self.robot, links[CASTER_LINK], lateralFriction=0.0,
+        # With no friction the ball caster carries weight but never steers the robot.
+        pybullet.changeDynamics(self.robot, links[CASTER_LINK], lateralFriction=caster_friction,
                                 rollingFriction=0.0, spinningFriction=0.0, **self._call)
+        self.links = links
         self.set_wheel_speeds(0.0, 0.0)
+        self._check_spawn_is_clear(spawn_pose)
+
+    def _add_obstacle(self, obstacle):
+        """A static body (mass 0) for a world_file.Obstacle."""
+        if obstacle.kind == 'box':
+            half = [edge / 2.0 for edge in obstacle.size]
+            shape = dict(shapeType=pybullet.GEOM_BOX, halfExtents=half)
+            collision = pybullet.createCollisionShape(halfExtents=half, shapeType=pybullet.GEOM_BOX,
+                                                      **self._call)
+        else:
+            radius, height = obstacle.size
+            shape = dict(shapeType=pybullet.GEOM_CYLINDER, radius=radius, length=height)
+            collision = pybullet.createCollisionShape(pybullet.GEOM_CYLINDER, radius=radius,
+                                                      height=height, **self._call)
+        visual = pybullet.createVisualShape(rgbaColor=obstacle.color, **dict(shape, **self._call))
+        body = pybullet.createMultiBody(0, collision, visual, obstacle.position,
+                                        yaw_to_quaternion(obstacle.yaw), **self._call)
+        pybullet.changeDynamics(body, -1, lateralFriction=GROUND_FRICTION, **self._call)
+        return body
+
+    def _check_spawn_is_clear(self, spawn_pose):
+        for index, body in enumerate(self.obstacles):
+            if pybullet.getClosestPoints(self.robot, body, 0.0, **self._call):
+                x, y = spawn_pose[:2]
+                raise ValueError('the spawn pose (%.2f, %.2f) puts the robot inside obstacle %d of '
+                                 'the world, centred at (%.2f, %.2f): choose another x_pos/y_pos'
+                                 % ((x, y, index + 1) + tuple(
+                                     pybullet.getBasePositionAndOrientation(body, **self._call)[0][:2])))
 
     def _load_robot(self, urdf_path, spawn_pose):
         x, y, z, yaw = spawn_pose
@@ -85,16 +119,40 @@ class SimWorld(object):
     def step(self):
         pybullet.stepSimulation(**self._call)
 
+    def reset_robot(self, pose):
+        """Put the robot at `pose` (x, y, z, yaw), at rest, wheels at angle 0."""
+        x, y, z, yaw = pose
+        pybullet.resetBasePositionAndOrientation(self.robot, [x, y, z], yaw_to_quaternion(yaw),
+                                                 **self._call)
+        pybullet.resetBaseVelocity(self.robot, [0, 0, 0], [0, 0, 0], **self._call)
+        for wheel in self.wheels:
+            pybullet.resetJointState(self.robot, wheel, 0.0, 0.0, **self._call)
+
     def base_pose(self):
         """Position (x, y, z) and orientation (x, y, z, w) of base_footprint in the world."""
         return pybullet.getBasePositionAndOrientation(self.robot, **self._call)
 
     def base_twist(self):
         """Linear and angular velocity of base_footprint, both in its own frame."""
-        linear, angular = pybullet.getBaseVelocity(self.robot, **self._call)
+        linear, angular = self.base_velocity()
         _, orientation = self.base_pose()
         world_from_base = np.reshape(pybullet.getMatrixFromQuaternion(orientation), (3, 3))
         return world_from_base.T.dot(linear), world_from_base.T.dot(angular)
+
+    def base_velocity(self):
+        """Linear and angular velocity of base_footprint in world axes."""
+        return pybullet.getBaseVelocity(self.robot, **self._call)
+
+    def link_pose(self, link):
+        """Position and orientation (x, y, z, w) of a robot link's frame in the world."""
+        state = pybullet.getLinkState(self.robot, self.links[link], **self._call)
+        return state[4], state[5]
+
+    def cast_rays(self, starts, ends):
+        """pybullet ray hits from `starts` to `ends` (N x 3), against static bodies only:
+        the robot's links are dynamic, so the robot never sees itself."""
+        return pybullet.rayTestBatch(starts.tolist(), ends.tolist(), numThreads=1,
+                                     collisionFilterMask=STATIC_BODIES, **self._call)
 
     def wheel_states(self):
         """Wheel angles (rad) and angular speeds (rad/s), left then right."""
