@@ -7,6 +7,7 @@ import os
 import sys
 import threading
 import time
+import warnings
 
 import rospkg
 import rospy
@@ -46,6 +47,20 @@ def _set_quaternion(quaternion, values):
     quaternion.x, quaternion.y, quaternion.z, quaternion.w = values
 
 
+def _publisher(topic, message_class, **options):
+    """A synchronous publisher: publish() writes to every subscriber's socket at once.
+
+    rospy's queued publishers hand each message to a writer thread per
+    subscriber; faster than real time the step loop starves those threads of
+    the GIL, and /clock then reaches subscribers in bursts, so their
+    rospy.Rate loops see time jump and drop ticks. Written in the step loop,
+    every tick leaves in order, at once. No Nagle delay for small messages.
+    """
+    with warnings.catch_warnings():  # rospy warns whenever queue_size is None
+        warnings.simplefilter('ignore', SyntaxWarning)
+        return rospy.Publisher(topic, message_class, queue_size=None, tcp_nodelay=True, **options)
+
+
 class _OnSubscribe(rospy.SubscribeListener):
     def __init__(self, callback):
         super(_OnSubscribe, self).__init__()
@@ -72,16 +87,13 @@ class SimulatorNode(object):
         self._max_lead_ns = int(round(config['max_clock_lead'] * 1e9))
         self._make_schedules()
         self._make_messages()
-        # Small messages at a high rate: no Nagle delays on loopback.
-        publish = dict(queue_size=10, tcp_nodelay=True)
-        self.clock_pub = rospy.Publisher('clock', Clock, subscriber_listener=_OnSubscribe(self._hold_clock),
-                                         **publish)
-        self.odom_pub = rospy.Publisher('odom', Odometry, **publish)
-        self.truth_pub = rospy.Publisher('base_pose_ground_truth', Odometry, **publish)
-        self.joints_pub = rospy.Publisher('joint_states', JointState, **publish)
-        self.tf_pub = rospy.Publisher('tf', TFMessage, queue_size=100, tcp_nodelay=True)
-        self.scan_pub = rospy.Publisher('scan', LaserScan, **publish) if simulation.lidar else None
-        self.imu_pub = rospy.Publisher('imu', Imu, **publish) if simulation.imu else None
+        self.clock_pub = _publisher('clock', Clock, subscriber_listener=_OnSubscribe(self._hold_clock))
+        self.odom_pub = _publisher('odom', Odometry)
+        self.truth_pub = _publisher('base_pose_ground_truth', Odometry)
+        self.joints_pub = _publisher('joint_states', JointState)
+        self.tf_pub = _publisher('tf', TFMessage)
+        self.scan_pub = _publisher('scan', LaserScan) if simulation.lidar else None
+        self.imu_pub = _publisher('imu', Imu) if simulation.imu else None
         rospy.Subscriber('cmd_vel', Twist, self._on_cmd_vel, queue_size=10, tcp_nodelay=True)
         rospy.Subscriber('clock', Clock, self._on_clock_echo, queue_size=1, tcp_nodelay=True)
         for name, handler in (('pause_physics', self._on_pause), ('unpause_physics', self._on_unpause),
@@ -210,9 +222,10 @@ class SimulatorNode(object):
             self.publish_odometry(stamp)
         if due['joint_states'].due(now_ns):
             self.publish_joint_states(stamp)
-        if self.scan_pub and due['scan'].due(now_ns):
+        # The sensors cost most of a step: nobody listening, nothing computed.
+        if self.scan_pub and due['scan'].due(now_ns) and self.scan_pub.get_num_connections():
             self.publish_scan(stamp)
-        if self.imu_pub and due['imu'].due(now_ns):
+        if self.imu_pub and due['imu'].due(now_ns) and self.imu_pub.get_num_connections():
             self.publish_imu(stamp)
 
     def publish_odometry(self, stamp):

@@ -151,7 +151,7 @@ class SimWorld(object):
     def cast_rays(self, starts, ends):
         """pybullet ray hits from `starts` to `ends` (N x 3), against static bodies only:
         the robot's links are dynamic, so the robot never sees itself."""
-        return pybullet.rayTestBatch(starts.tolist(), ends.tolist(), numThreads=1,
+        return pybullet.rayTestBatch(starts, ends, numThreads=1,
                                      collisionFilterMask=STATIC_BODIES, **self._call)
 
     def wheel_states(self):
