@@ -49,5 +49,8 @@ lint: setup
 bench: setup
 	$(IN_ROS) python3 tools/bench.py
 
+soak: setup
+	$(IN_ROS) python3 tools/soak.py --check
+
 clean:
 	rm -rf $(WS) $(VENV)

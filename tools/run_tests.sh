@@ -23,6 +23,11 @@ for test_file in test/*.test; do
   timeout --signal=INT --kill-after=20 600 rostest --text tb3_sim_nav "$name" || failures+=("$name")
 done
 
+if [ "${1:-}" != --integration-only ]; then
+  echo "== short soak: 120 s of sim time under random and hostile commands"
+  timeout --signal=INT --kill-after=20 600 python3 tools/soak.py --sim-seconds 120 --check || failures+=(soak)
+fi
+
 if [ ${#failures[@]} -gt 0 ]; then
   echo "FAILED: ${failures[*]}"
   exit 1

@@ -60,11 +60,11 @@ def _at_least(minimum):
 PROFILES = {
     'gazebo': dict(odom_source='world', ground_friction=1.0, caster_friction=0.0,
                    odom_wheel_radius_error=0.0, odom_wheel_separation_error=0.0,
-                   encoder_noise=0.0, max_wheel_acceleration=0.0, cmd_vel_timeout=0.0,
+                   encoder_noise=0.0, cmd_vel_timeout=0.0,
                    imu_gyro_noise=2e-4, imu_accel_noise=1.7e-2),
     'realistic': dict(odom_source='encoders', ground_friction=0.8, caster_friction=0.3,
                       odom_wheel_radius_error=0.01, odom_wheel_separation_error=-0.04,
-                      encoder_noise=0.002, max_wheel_acceleration=30.0, cmd_vel_timeout=0.5,
+                      encoder_noise=0.002, cmd_vel_timeout=0.5,
                       imu_gyro_noise=2e-3, imu_accel_noise=5e-2),
 }
 
@@ -86,6 +86,7 @@ PARAMETERS = [
     Parameter('max_linear_speed', 0.22, float, _positive, 'm/s', 'commands beyond this are clamped'),
     Parameter('max_angular_speed', 2.84, float, _positive, 'rad/s', 'commands beyond this are clamped'),
     Parameter('wheel_torque', 1.5, float, _positive, 'N m', 'stall torque of each wheel motor (Dynamixel XL430 at 12 V)'),
+    Parameter('wheel_acceleration', 1.0, float, _non_negative, 'm/s^2', "limit on each wheel rim's acceleration, as TurtleBot3's Gazebo set-up (wheelAcceleration 1); 0 = none"),
     Parameter('odom_frame', 'odom', str, _frame_id, '', 'frame of odom and of its tf parent'),
     Parameter('base_frame', 'base_footprint', str, _frame_id, '', 'child frame of odom and its tf'),
     Parameter('scan', True, bool, None, '', 'publish the LDS-01 lidar on scan'),
@@ -104,7 +105,6 @@ PARAMETERS = [
     Parameter('odom_wheel_radius_error', None, float, _fraction, 'fraction', 'encoder odometry assumes a wheel this much bigger than the real one'),
     Parameter('odom_wheel_separation_error', None, float, _fraction, 'fraction', 'encoder odometry assumes wheels this much further apart than they act'),
     Parameter('encoder_noise', None, float, _non_negative, 'rad', 'standard deviation of Gaussian noise on each wheel-angle reading'),
-    Parameter('max_wheel_acceleration', None, float, _non_negative, 'rad/s^2', 'motor acceleration limit; 0 = none'),
     Parameter('cmd_vel_timeout', None, float, _non_negative, 's', 'stop when no cmd_vel came for this long (firmware: 0.5); 0 = hold the last command forever'),
     Parameter('imu_gyro_noise', None, float, _non_negative, 'rad/s', 'standard deviation of angular-velocity noise'),
     Parameter('imu_accel_noise', None, float, _non_negative, 'm/s^2', 'standard deviation of linear-acceleration noise'),

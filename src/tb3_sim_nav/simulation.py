@@ -64,7 +64,7 @@ class Simulation(object):
         if (timeout > 0.0 and self._last_command_ns is not None
                 and self.now_ns - self._last_command_ns > timeout * 1e9):
             target = (0.0, 0.0)
-        limit = self.config['max_wheel_acceleration'] * self.step_ns * 1e-9
+        limit = self.config['wheel_acceleration'] / self.geometry.wheel_radius * self.step_ns * 1e-9
         if limit > 0.0:
             target = tuple(current + max(-limit, min(limit, wanted - current))
                            for current, wanted in zip(self._wheels, target))

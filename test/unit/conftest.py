@@ -20,3 +20,8 @@ def repo():
 @pytest.fixture
 def burger_urdf():
     return REPO / 'urdf' / 'turtlebot3_burger.urdf'
+
+
+@pytest.fixture
+def worlds_folder():
+    return REPO / 'worlds'

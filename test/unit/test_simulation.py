@@ -1,0 +1,249 @@
+"""Simulation (no ROS): profiles, odometry, command timeout, acceleration limit, resets, friction."""
+import math
+
+import pybullet
+import pytest
+
+from tb3_sim_nav.diff_drive import quaternion_to_yaw, wheel_speeds
+from tb3_sim_nav.params import PARAMETERS, resolve
+from tb3_sim_nav.robot_model import read_drive_geometry
+from tb3_sim_nav.simulation import Simulation
+from tb3_sim_nav.world_file import load_world
+
+RATE = 200  # physics_rate default
+COMMAND_EVERY = 20  # steps: `rostopic pub -r 10`
+ODOM_EVERY = 7      # steps: odom at ~30 Hz, as the node reads it
+
+
+@pytest.fixture
+def make_sim(burger_urdf):
+    """make_sim(obstacles=(), **parameters): a Simulation, closed after the test."""
+    sims = []
+    geometry = read_drive_geometry(str(burger_urdf))
+
+    def make(obstacles=(), **overrides):
+        # resolve() ignores names it does not know: a renamed parameter must fail here.
+        assert set(overrides) <= {parameter.name for parameter in PARAMETERS}, overrides
+        overrides.setdefault('urdf_file', str(burger_urdf))
+        config = resolve(lambda name, default: overrides.get(name, default))
+        sim = Simulation(config, geometry, obstacles)
+        sims.append(sim)
+        return sim
+    yield make
+    for sim in sims:
+        sim.close()
+
+
+def run(sim, seconds, command=None):
+    """Step for `seconds`; re-send `command` (v, w) at 10 Hz; read odometry at ~30 Hz."""
+    for step in range(int(round(seconds * RATE))):
+        if command is not None and step % COMMAND_EVERY == 0:
+            sim.command(*command)
+        if step % ODOM_EVERY == 0:
+            sim.odometry_pose()
+        sim.step()
+
+
+def out_and_back(sim):
+    """1 m out, half a turn, 1 m back, then a stop; returns (true pose, odometry pose)."""
+    run(sim, 5.0, (0.2, 0.0))
+    run(sim, math.pi, (0.0, 1.0))
+    run(sim, 5.0, (0.2, 0.0))
+    run(sim, 0.5, (0.0, 0.0))
+    return pose(sim.true_pose()), pose(sim.odometry_pose())
+
+
+def pose(position_orientation):
+    """(x, y, yaw)."""
+    position, orientation = position_orientation
+    return position[0], position[1], quaternion_to_yaw(*orientation)
+
+
+def angle_between(a, b):
+    return abs(math.remainder(a - b, 2 * math.pi))
+
+
+def forward_speed(sim):
+    return sim.true_twist()[0][0]
+
+
+# --- driving and odometry ------------------------------------------------------------
+
+def test_straight_command_for_5_s_drives_1_m(make_sim):
+    sim = make_sim()
+    sim.command(0.2, 0.0)  # once: the default profile holds it
+    run(sim, 5.0)
+    x, y, yaw = pose(sim.true_pose())
+    ramp_loss = 0.2 ** 2 / (2 * sim.config['wheel_acceleration'])  # 2 cm at 1 m/s^2
+    assert x == pytest.approx(1.0 - ramp_loss, abs=0.005)
+    assert abs(y) < 0.005 and angle_between(yaw, 0.0) < math.radians(1.0)
+
+
+def test_gazebo_profile_odometry_is_the_true_pose(make_sim):
+    sim = make_sim()
+    run(sim, 2.0, (0.15, 0.6))
+    assert sim.odometry_pose() == sim.true_pose()
+    true_linear, true_angular = sim.true_twist()
+    odom_linear, odom_angular = sim.odometry_twist()
+    assert list(odom_linear) == list(true_linear) and list(odom_angular) == list(true_angular)
+    assert pose(sim.true_pose())[0] > 0.2  # it did move
+
+
+def test_realistic_odometry_drifts_from_the_truth(make_sim):
+    sim = make_sim(profile='realistic', seed=3)
+    (x, y, yaw), (odom_x, odom_y, odom_yaw) = out_and_back(sim)
+    assert math.hypot(x, y) < 0.5  # it did come back, roughly
+    drift = math.hypot(odom_x - x, odom_y - y)
+    assert drift > 0.01 or angle_between(odom_yaw, yaw) > math.radians(1.0)
+
+
+def test_realistic_runs_with_the_same_seed_are_identical(make_sim):
+    first = out_and_back(make_sim(profile='realistic', seed=3))
+    second = out_and_back(make_sim(profile='realistic', seed=3))
+    assert first == second
+
+
+def test_another_seed_changes_only_the_noisy_odometry(make_sim):
+    true_a, odom_a = out_and_back(make_sim(profile='realistic', seed=3))
+    true_b, odom_b = out_and_back(make_sim(profile='realistic', seed=4))
+    assert true_a == true_b  # physics has no noise
+    assert odom_a != odom_b  # encoder noise does
+
+
+# --- cmd_vel timeout -----------------------------------------------------------------
+
+def test_robot_stops_after_cmd_vel_timeout(make_sim):
+    sim = make_sim(cmd_vel_timeout=0.5)
+    sim.command(0.2, 0.0)
+    run(sim, 0.4)
+    assert forward_speed(sim) == pytest.approx(0.2, abs=0.01)
+    run(sim, 0.4)  # to timeout + 0.3 s
+    assert abs(forward_speed(sim)) < 0.005
+
+
+def test_repeated_commands_keep_the_robot_going_past_the_timeout(make_sim):
+    sim = make_sim(cmd_vel_timeout=0.5)
+    run(sim, 2.0, (0.2, 0.0))
+    assert forward_speed(sim) == pytest.approx(0.2, abs=0.01)
+
+
+def test_zero_timeout_holds_the_last_command(make_sim):
+    sim = make_sim(cmd_vel_timeout=0.0)
+    sim.command(0.2, 0.0)
+    run(sim, 3.0)
+    assert forward_speed(sim) == pytest.approx(0.2, abs=0.01)
+
+
+# --- acceleration limit --------------------------------------------------------------
+
+def wheel_speeds_after(sim, seconds, v):
+    sim.command(v, 0.0)
+    run(sim, seconds)
+    return sim.wheel_states()[1]
+
+
+def test_wheel_acceleration_limit_slows_the_spin_up(make_sim, burger_urdf):
+    radius, separation = read_drive_geometry(str(burger_urdf))
+    target = wheel_speeds(0.2, 0.0, radius, separation)[0]
+    limited = wheel_speeds_after(make_sim(wheel_acceleration=0.5), 0.1, 0.2)
+    assert limited == pytest.approx([0.5 / radius * 0.1] * 2, rel=0.05)  # not the target
+    free = wheel_speeds_after(make_sim(wheel_acceleration=0.0), 0.1, 0.2)
+    assert free == pytest.approx([target] * 2, rel=0.05)
+
+
+def test_wheel_acceleration_limit_also_limits_braking(make_sim, burger_urdf):
+    radius, _separation = read_drive_geometry(str(burger_urdf))
+    sim = make_sim(wheel_acceleration=0.5)
+    wheel_speeds_after(sim, 1.0, 0.2)
+    braking = wheel_speeds_after(sim, 0.1, 0.0)
+    assert braking == pytest.approx([(0.2 - 0.5 * 0.1) / radius] * 2, rel=0.05)
+
+
+def test_default_wheel_acceleration_is_gazebos_1_m_s2(make_sim, burger_urdf):
+    radius, _separation = read_drive_geometry(str(burger_urdf))
+    speeds = wheel_speeds_after(make_sim(), 0.1, 0.2)
+    assert speeds == pytest.approx([1.0 / radius * 0.1] * 2, rel=0.05)
+
+
+# --- resets --------------------------------------------------------------------------
+
+SPAWN = dict(x_pos=0.5, y_pos=-0.3, yaw=0.7)
+
+
+def test_reset_world_puts_the_robot_back_at_rest_and_time_runs_on(make_sim):
+    sim = make_sim(odom_source='encoders', **SPAWN)
+    sim.command(0.2, 0.5)
+    run(sim, 1.0)
+    assert math.hypot(*pose(sim.true_pose())[:2]) > 0.6  # it moved away
+    steps = sim.steps
+    sim.reset_world()
+    assert sim.steps == steps
+    for _ in range(2):  # right after the reset, and 0.5 s later: still there, still at rest
+        assert pose(sim.true_pose()) == pytest.approx((0.5, -0.3, 0.7), abs=1e-3)
+        assert pose(sim.odometry_pose()) == pytest.approx((0.5, -0.3, 0.7), abs=1e-3)
+        linear, angular = sim.true_twist()
+        assert max(map(abs, linear)) < 1e-3 and max(map(abs, angular)) < 1e-3
+        run(sim, 0.5)
+    assert sim.steps == steps + RATE
+
+
+def test_reset_world_zeroes_the_wheel_angles(make_sim):
+    sim = make_sim()
+    sim.command(0.2, 0.0)
+    run(sim, 1.0)
+    sim.reset_world()
+    angles, speeds = sim.wheel_states()
+    assert angles == [0.0, 0.0] and speeds == [0.0, 0.0]
+
+
+def test_reset_simulation_also_sets_time_to_zero(make_sim):
+    sim = make_sim(**SPAWN)
+    sim.command(0.2, 0.0)
+    run(sim, 1.0)
+    sim.reset_simulation()
+    assert sim.steps == 0 and sim.now_ns == 0
+    assert pose(sim.true_pose()) == pytest.approx((0.5, -0.3, 0.7), abs=1e-3)
+
+
+# --- spawning ------------------------------------------------------------------------
+
+def test_spawning_inside_an_obstacle_names_it(make_sim, worlds_folder):
+    obstacles = load_world('turtlebot3_world', str(worlds_folder))
+    with pytest.raises(ValueError, match='obstacle 11'):  # the centre pillar
+        make_sim(obstacles, x_pos=0.0, y_pos=0.0)
+
+
+def test_the_launch_spawn_pose_in_turtlebot3_world_is_clear(make_sim, worlds_folder):
+    sim = make_sim(load_world('turtlebot3_world', str(worlds_folder)), x_pos=-2.0, y_pos=-0.5)
+    assert pose(sim.true_pose())[:2] == pytest.approx((-2.0, -0.5))
+
+
+def connected_clients():
+    return sum(bool(pybullet.isConnected(client)) for client in range(64))
+
+
+def test_a_refused_spawn_leaves_no_pybullet_client_open(make_sim, worlds_folder):
+    obstacles = load_world('turtlebot3_world', str(worlds_folder))
+    before = connected_clients()
+    with pytest.raises(ValueError):
+        make_sim(obstacles, x_pos=0.0, y_pos=0.0)
+    assert connected_clients() == before
+
+
+# --- friction ------------------------------------------------------------------------
+
+def quarter_turn(make_sim, caster_friction):
+    """Yaw (deg) after a timed 90 deg in-place turn, as in the tutorial's scripts."""
+    sim = make_sim(caster_friction=caster_friction, ground_friction=0.8)
+    sim.command(0.0, 1.0)
+    run(sim, math.pi / 2)
+    sim.command(0.0, 0.0)
+    run(sim, 0.5)
+    return math.degrees(pose(sim.true_pose())[2])
+
+
+def test_caster_friction_makes_a_timed_turn_fall_short(make_sim):
+    free, dragging, stuck = (quarter_turn(make_sim, friction) for friction in (0.0, 0.5, 1.0))
+    assert free == pytest.approx(90.0, abs=0.5)
+    assert free - dragging > 0.2
+    assert free - stuck > 5.0

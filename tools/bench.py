@@ -1,0 +1,250 @@
+"""`make bench`: speed, CPU, memory and start-up of the simulator, as a table.
+
+Run inside `source setup.bash`. A benchmark, not a test: it measures and
+prints medians over several runs, with the machine and the date, and marks
+each figure against its target. It starts one master on a free loopback port
+and stops everything it starts by process group (the demo's machinery).
+
+    python3 tools/bench.py [--runs N] [--quick]
+"""
+import argparse
+import datetime
+import math
+import os
+import platform
+import statistics
+import sys
+import time
+import xmlrpc.client
+
+import demo
+import demo_report
+from demo import Process, say
+
+LAUNCH = ['roslaunch', '--wait', 'tb3_sim_bringup', 'tb3_empty_world.launch']
+TOPICS = ['clock', 'odom', 'tf', 'joint_states', 'base_pose_ground_truth', 'scan', 'imu']
+SENSOR_SETS = [('every topic on', {}), ('without scan', {'scan': False}),
+               ('without imu', {'imu': False}), ('without scan and imu', {'scan': False, 'imu': False})]
+TARGETS = {'rtf': 30.0, 'cpu': 5.0, 'startup': 3.0, 'speedup': 10.0}
+
+
+def machine():
+    model = 'unknown CPU'
+    with open('/proc/cpuinfo') as cpuinfo:
+        for line in cpuinfo:
+            if line.startswith('model name'):
+                model = line.split(':', 1)[1].strip()
+                break
+    return '%s, %d cores, %s, Python %s' % (model, os.cpu_count(), platform.platform(terse=True),
+                                            platform.python_version())
+
+
+def sim_pid():
+    """PID of the /tb3_sim node, from its own XML-RPC API."""
+    import rosgraph
+    uri = rosgraph.Master('/tb3_bench').lookupNode('/tb3_sim')
+    return xmlrpc.client.ServerProxy(uri).getPid('/tb3_bench')[2]
+
+
+def cpu_seconds(pid):
+    """User + system CPU time (s) of a process and its threads."""
+    with open('/proc/%d/stat' % pid) as stat:
+        fields = stat.read().rsplit(')', 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+def peak_rss_mib(pid):
+    with open('/proc/%d/status' % pid) as status:
+        for line in status:
+            if line.startswith('VmHWM:'):
+                return int(line.split()[1]) / 1024.0
+    return float('nan')
+
+
+class Listener(object):
+    """Subscribes to every topic of the simulator (so every sensor is computed)
+    without deserialising, and notes the newest /clock and the first tf."""
+
+    def __init__(self):
+        import rospy
+        from rosgraph_msgs.msg import Clock
+        from tf2_msgs.msg import TFMessage
+        self.clock = None
+        self.first_tf_wall = None
+        self.subscribers = [rospy.Subscriber(topic, rospy.AnyMsg, lambda _message: None, queue_size=1)
+                            for topic in TOPICS if topic not in ('clock', 'tf')]
+        self.subscribers.append(rospy.Subscriber('clock', Clock, self._on_clock, queue_size=1))
+        self.subscribers.append(rospy.Subscriber('tf', TFMessage, self._on_tf, queue_size=10))
+
+    def _on_clock(self, message):
+        self.clock = message.clock.to_sec()
+
+    def _on_tf(self, message):
+        if self.first_tf_wall is None and any(t.child_frame_id == 'base_footprint' for t in message.transforms):
+            self.first_tf_wall = time.monotonic()
+
+    def close(self):
+        for subscriber in self.subscribers:
+            subscriber.unregister()
+
+
+def start_sim(name, log_dir, factor, params=None):
+    """The tutorial's launch at `factor`; `params` are private parameters of /tb3_sim."""
+    import rosgraph
+    master = rosgraph.Master('/tb3_bench')
+    for key in ('scan', 'imu'):
+        master.setParam('/tb3_sim/' + key, (params or {}).get(key, True))
+    return Process(name, LAUNCH + ['real_time_factor:=%g' % factor], log_dir)
+
+
+def wait_until(predicate, timeout, what):
+    deadline = time.monotonic() + timeout
+    while not predicate():
+        if time.monotonic() > deadline:
+            raise demo.DemoError('no %s within %.0f s' % (what, timeout))
+        time.sleep(0.01)
+
+
+def measure_rtf(log_dir, params, seconds):
+    """Sim seconds per wall second at factor 0, and the node's peak RSS."""
+    listener = Listener()
+    sim = start_sim('rtf', log_dir, 0.0, params)
+    try:
+        wait_until(lambda: listener.clock is not None and listener.clock > 1.0, 60, '/clock')
+        time.sleep(1.0)
+        sim_start, wall_start = listener.clock, time.monotonic()
+        time.sleep(seconds)
+        rtf = (listener.clock - sim_start) / (time.monotonic() - wall_start)
+        return rtf, peak_rss_mib(sim_pid())
+    finally:
+        listener.close()
+        sim.stop()
+
+
+def measure_cpu_and_startup(log_dir, seconds):
+    """CPU of the node at factor 1 while driving a circle, its peak RSS, and
+    the wall time from `roslaunch` to the first odom -> base_footprint."""
+    import rospy
+    from geometry_msgs.msg import Twist
+    listener = Listener()
+    launched = time.monotonic()
+    sim = start_sim('cpu', log_dir, 1.0)
+    publisher = rospy.Publisher('cmd_vel', Twist, queue_size=1)
+    try:
+        wait_until(lambda: listener.first_tf_wall is not None, 60, 'odom -> base_footprint')
+        startup = listener.first_tf_wall - launched
+        pid = sim_pid()
+        command = Twist()
+        command.linear.x, command.angular.z = 0.1, -0.5
+        time.sleep(1.0)
+        cpu_start, wall_start = cpu_seconds(pid), time.monotonic()
+        while time.monotonic() - wall_start < seconds:
+            publisher.publish(command)
+            time.sleep(0.1)
+        cpu = 100.0 * (cpu_seconds(pid) - cpu_start) / (time.monotonic() - wall_start)
+        return cpu, peak_rss_mib(pid), startup
+    finally:
+        publisher.unregister()
+        listener.close()
+        sim.stop()
+
+
+def run_scripts(log_dir, factor):
+    """Each tutorial script on a fresh simulator at `factor`: wall time and end pose."""
+    options = argparse.Namespace(real_time_factor=factor, profile=None)
+    results = {}
+    for script, expected in demo.SCRIPTS:
+        result, error = demo.run_script(script, expected, options, log_dir)
+        if error:
+            raise demo.DemoError('%s at factor %g: %s' % (script, factor, error))
+        results[script] = (result.wall_time, demo_report.summarize(result).end)
+    return results
+
+
+def median(values):
+    return statistics.median(values) if values else float('nan')
+
+
+def verdict(ok):
+    return 'met' if ok else 'MISSED'
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--runs', type=int, default=3, help='runs per figure (median reported)')
+    parser.add_argument('--seconds', type=float, default=10.0, help='wall s per real-time-factor run')
+    parser.add_argument('--cpu-seconds', type=float, default=30.0, help='wall s of the CPU measurement')
+    parser.add_argument('--skip-scripts', action='store_true', help='leave out the tutorial scripts')
+    parser.add_argument('--output', default=os.path.join(demo.ROOT, 'bench_output'))
+    args = parser.parse_args(argv)
+    log_dir = os.path.join(args.output, 'logs')
+    os.makedirs(log_dir, exist_ok=True)
+    master = None
+    lines = []
+    try:
+        master = demo.start_master(log_dir)
+        import rospy
+        rospy.init_node('tb3_bench', anonymous=True, argv=[sys.argv[0]], disable_signals=True)
+        rtf, rss = {}, []
+        for label, params in SENSOR_SETS:
+            rtf[label] = []
+            for run in range(args.runs):
+                value, peak = measure_rtf(log_dir, params, args.seconds)
+                say('max real-time factor, %s, run %d: %.1f' % (label, run + 1, value))
+                rtf[label].append(value)
+                rss.append(peak)
+        cpu, startup = [], []
+        for run in range(args.runs):
+            used, peak, started = measure_cpu_and_startup(log_dir, args.cpu_seconds)
+            say('factor 1 while driving, run %d: %.1f %% of a core, start-up %.2f s' % (run + 1, used, started))
+            cpu.append(used)
+            rss.append(peak)
+            startup.append(started)
+        scripts = {}
+        if not args.skip_scripts:
+            for factor in (1.0, 0.0):
+                scripts[factor] = run_scripts(log_dir, factor)
+
+        full = median(rtf['every topic on'])
+        lines += ['tb3_sim_nav benchmark, %s' % datetime.date.today().isoformat(),
+                  'machine: %s' % machine(),
+                  'medians of %d runs; real-time factor = sim seconds per wall second' % args.runs, '',
+                  '%-58s %12s  %s' % ('figure', 'value', 'target'),
+                  '%-58s %12.1f  >= %g: %s' % ('max real-time factor, headless empty world, every topic on',
+                                              full, TARGETS['rtf'], verdict(full >= TARGETS['rtf']))]
+        for label, _ in SENSOR_SETS[1:]:
+            lines.append('%-58s %12.1f' % ('max real-time factor, ' + label, median(rtf[label])))
+        lines += ['%-58s %11.1f%%  < %g %%: %s' % ('CPU of the simulator at factor 1, driving (% of a core)',
+                                                   median(cpu), TARGETS['cpu'], verdict(median(cpu) < TARGETS['cpu'])),
+                  '%-58s %8.0f MiB' % ('peak RSS of the simulator node (max over runs)', max(rss)),
+                  '%-58s %10.2f s  < %g s: %s' % ('start-up: roslaunch to first odom->base_footprint',
+                                                  median(startup), TARGETS['startup'],
+                                                  verdict(median(startup) < TARGETS['startup']))]
+        for script, _ in (demo.SCRIPTS if scripts else []):
+            (wall_1, end_1), (wall_0, end_0) = scripts[1.0][script], scripts[0.0][script]
+            ratio = wall_1 / wall_0
+            apart = math.hypot(end_0[1] - end_1[1], end_0[2] - end_1[2])
+            turn = abs(math.degrees(demo_report.normalize(end_0[3] - end_1[3])))
+            lines += ['%-58s %7.1f s / %.1f s = %.1fx  >= %gx: %s'
+                      % (script + ' wall time, factor 1 / factor 0', wall_1, wall_0, ratio,
+                         TARGETS['speedup'], verdict(ratio >= TARGETS['speedup'])),
+                      '%-58s %6.3f m %5.2f deg  (ends %+.3f %+.3f %+.1f deg / %+.3f %+.3f %+.1f deg)'
+                      % ('  end pose, factor 0 against factor 1', apart, turn,
+                         end_1[1], end_1[2], math.degrees(end_1[3]), end_0[1], end_0[2], math.degrees(end_0[3]))]
+    except demo.DemoError as error:
+        print('bench FAILED: %s' % error, file=sys.stderr)
+        return 1
+    finally:
+        if master is not None:
+            import rospy
+            rospy.signal_shutdown('bench done')
+            master.stop()
+    text = '\n'.join(lines)
+    print('\n' + text)
+    with open(os.path.join(args.output, 'bench.txt'), 'w') as table:
+        table.write(text + '\n')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
