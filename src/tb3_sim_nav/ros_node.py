@@ -9,6 +9,7 @@ import threading
 import time
 import warnings
 
+import rosgraph
 import rospkg
 import rospy
 from geometry_msgs.msg import TransformStamped, Twist
@@ -266,6 +267,62 @@ class SimulatorNode(object):
         self.imu_pub.publish(self._imu)
 
 
+class MasterWatch(threading.Thread):
+    """Registers this node again with a master that was restarted.
+
+    Peer-to-peer connections survive a master's restart, but a new master
+    knows no node: without this, nodes started afterwards would never find
+    the simulator. Parameters the tutorial's nodes need (/use_sim_time,
+    /robot_description) are set again too.
+    """
+    PERIOD = 1.0  # wall s between looks at the master
+    RESTORED_PARAMETERS = ('/use_sim_time', '/robot_description')
+
+    def __init__(self):
+        super(MasterWatch, self).__init__(name='master_watch', daemon=True)
+        self.master = rosgraph.Master(rospy.get_name())
+        self.parameters = dict((name, rospy.get_param(name)) for name in self.RESTORED_PARAMETERS
+                               if rospy.has_param(name))
+        self.master_pid = self.master.getPid()
+
+    def run(self):
+        reachable = True
+        while not rospy.is_shutdown():
+            time.sleep(self.PERIOD)
+            try:
+                pid = self.master.getPid()
+            except Exception:  # refused, reset, timed out: all mean "not there now"
+                if reachable:
+                    rospy.logwarn('the ROS master at %s is gone: simulating on; nodes already connected '
+                                  'keep their topics; waiting for a master to come back',
+                                  self.master.master_uri)
+                reachable = False
+                continue
+            if pid != self.master_pid:
+                self._register_again()
+                self.master_pid = pid
+                rospy.logwarn('a new ROS master is up at %s: registered /tb3_sim\'s topics and services '
+                              'with it again', self.master.master_uri)
+            reachable = True
+
+    def _register_again(self):
+        from rospy.impl import registration
+        topics, services = registration.get_topic_manager(), registration.get_service_manager()
+        uri = rospy.core.get_node_uri()
+        for name, value in self.parameters.items():
+            self.master.setParam(name, value)
+        managers = [listener for listener in registration.get_registration_listeners().listeners
+                    if isinstance(listener, registration.RegManager)]
+        for topic, message_type in topics.get_publications():
+            self.master.registerPublisher(topic, message_type, uri)
+        for topic, message_type in topics.get_subscriptions():
+            publishers = self.master.registerSubscriber(topic, message_type, uri)
+            for manager in managers:
+                manager.publisher_update(topic, publishers)
+        for service, service_uri in services.get_services():
+            self.master.registerService(service, service_uri, uri)
+
+
 def _start_up():
     """Parameters, URDF and world checked, or a fatal message and exit status 2."""
     try:
@@ -298,6 +355,8 @@ def main():
         # script starved of CPU would react late in sim time.
         os.nice(10)
     try:
-        SimulatorNode(config, simulation).run()
+        node = SimulatorNode(config, simulation)
+        MasterWatch().start()
+        node.run()
     finally:
         simulation.close()

@@ -51,7 +51,11 @@ class SimWorld(object):
                                 rollingFriction=0.0, spinningFriction=0.0, **self._call)
         self.links = links
         self.set_wheel_speeds(0.0, 0.0)
-        self._check_spawn_is_clear(spawn_pose)
+        try:
+            self._check_spawn_is_clear(spawn_pose)
+        except ValueError:
+            self.close()
+            raise
 
     def _add_obstacle(self, obstacle):
         """A static body (mass 0) for a world_file.Obstacle."""

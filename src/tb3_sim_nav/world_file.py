@@ -97,8 +97,11 @@ def load_world(world, worlds_folder):
         document = {}
     if not isinstance(document, dict) or set(document) - {'obstacles'}:
         raise WorldError('world file %s: the top level must be a mapping with the one key '
-                         '"obstacles"' % path)
-    entries = document.get('obstacles') or []
+                         '"obstacles", not %r' % (path, sorted(document) if isinstance(document, dict)
+                                                  else document))
+    entries = document.get('obstacles', [])
+    if entries is None:  # "obstacles:" with nothing after it
+        entries = []
     if not isinstance(entries, list):
         raise WorldError('world file %s: "obstacles" must be a list' % path)
     obstacles = []
