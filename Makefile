@@ -32,7 +32,7 @@ $(WS)/devel/.ready: CMakeLists.txt package.xml setup.py env-hooks/* $(wildcard s
 	touch $@
 
 demo: setup
-	$(IN_ROS) python3 tools/demo.py
+	$(IN_ROS) python3 tools/demo.py $(DEMO_ARGS)
 
 test: setup
 	$(IN_ROS) bash tools/run_tests.sh
@@ -47,7 +47,7 @@ lint: setup
 	$(IN_ROS) catkin_lint --strict -W2 .
 
 bench: setup
-	$(IN_ROS) python3 tools/bench.py
+	$(IN_ROS) python3 tools/bench.py $(BENCH_ARGS)
 
 soak: setup
 	$(IN_ROS) python3 tools/soak.py --check

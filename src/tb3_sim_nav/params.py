@@ -79,7 +79,7 @@ PARAMETERS = [
     Parameter('real_time_factor', 1.0, float, _non_negative, '', 'simulated seconds per wall second; 0 = as fast as possible'),
     Parameter('paused', False, bool, None, '', 'start with physics paused (/gazebo/unpause_physics resumes)'),
     Parameter('physics_rate', 200.0, float, _positive, 'Hz', 'physics steps per simulated second; /clock is published every step'),
-    Parameter('max_clock_lead', 0.01, float, _non_negative, 's', 'how far /clock may run ahead of what a python subscriber has received'),
+    Parameter('max_clock_lead', 0.01, float, _non_negative, 's', 'faster than real time, how far /clock may run ahead of what a python subscriber of its own has received'),
     Parameter('startup_hold', 0.5, float, _non_negative, 's (wall)', 'sim time holds this long when a node subscribes to /clock, so it can connect first'),
     Parameter('odom_rate', 30.0, float, _positive, 'Hz', 'rate of odom, tf and base_pose_ground_truth (sim time)'),
     Parameter('joint_states_rate', 30.0, float, _positive, 'Hz', 'rate of joint_states (sim time)'),

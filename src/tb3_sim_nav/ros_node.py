@@ -96,7 +96,10 @@ class SimulatorNode(object):
         self.scan_pub = _publisher('scan', LaserScan) if simulation.lidar else None
         self.imu_pub = _publisher('imu', Imu) if simulation.imu else None
         rospy.Subscriber('cmd_vel', Twist, self._on_cmd_vel, queue_size=10, tcp_nodelay=True)
-        rospy.Subscriber('clock', Clock, self._on_clock_echo, queue_size=1, tcp_nodelay=True)
+        # Faster than real time only: listen to our own /clock (see _wait_for_echo).
+        self._echoing = not 0.0 < config['real_time_factor'] <= 1.0
+        if self._echoing:
+            rospy.Subscriber('clock', Clock, self._on_clock_echo, queue_size=1, tcp_nodelay=True)
         for name, handler in (('pause_physics', self._on_pause), ('unpause_physics', self._on_unpause),
                               ('reset_world', self._on_reset_world),
                               ('reset_simulation', self._on_reset_simulation)):
@@ -207,7 +210,8 @@ class SimulatorNode(object):
             self.pacer.wait_until((self.sim.steps + 1) * self.sim.step_ns * 1e-9)
             with self._lock:
                 self.step()
-            self._wait_for_echo(self.sim.now_ns)
+            if self._echoing:
+                self._wait_for_echo(self.sim.now_ns)
 
     def step(self):
         v, w, count = self._command
