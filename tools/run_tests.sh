@@ -19,8 +19,9 @@ fi
 for test_file in test/*.test; do
   name=$(basename "$test_file")
   echo "== rostest tb3_sim_nav $name"
-  # SIGINT first: rostest then stops every node it started.
-  timeout --signal=INT --kill-after=20 600 rostest --text tb3_sim_nav "$name" || failures+=("$name")
+  # Not --text: with it rostest exits 0 even when a test fails. SIGINT first on
+  # a time-out: rostest then stops every node it started.
+  timeout --signal=INT --kill-after=20 600 rostest tb3_sim_nav "$name" || failures+=("$name")
 done
 
 if [ "${1:-}" != --integration-only ]; then

@@ -23,6 +23,7 @@ from . import params
 from .diff_drive import Limits, sanitize_twist
 from .pacing import Pacer, Schedule
 from .robot_model import LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT, ModelError, read_drive_geometry
+from .throttle import Throttle
 from .world_file import WorldError, load_world
 
 WARN_PERIOD = 5.0    # s between repeats of the same warning
@@ -80,6 +81,7 @@ class SimulatorNode(object):
         self.limits = Limits(config['max_linear_speed'], config['max_angular_speed'])
         self.pacer = Pacer(config['real_time_factor'], paused=config['paused'])
         self._lock = threading.Lock()  # steps versus reset services
+        self._warnings = Throttle(WARN_PERIOD)
         self._command = (0.0, 0.0, 0)  # v, w, count of commands received
         self._applied_count = 0
         self._hold_until = 0.0
@@ -146,8 +148,11 @@ class SimulatorNode(object):
         v, w, complaints = sanitize_twist((twist.linear.x, twist.linear.y, twist.linear.z),
                                           (twist.angular.x, twist.angular.y, twist.angular.z),
                                           self.limits)
-        if complaints:
-            rospy.logwarn_throttle(WARN_PERIOD, 'cmd_vel: ' + '; '.join(complaints))
+        for complaint in complaints:
+            # Throttled per kind (its first word), so that a flood of one kind
+            # of bad command cannot hide another.
+            if self._warnings.allow(complaint.split()[0]):
+                rospy.logwarn('cmd_vel: %s (at most one such warning per %g s)', complaint, WARN_PERIOD)
         self._command = (v, w, self._command[2] + 1)  # one assignment; the step loop picks it up
 
     def _hold_clock(self):

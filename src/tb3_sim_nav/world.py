@@ -3,6 +3,7 @@
 The world knows nothing of ROS, time pacing or I/O; callers set wheel speeds,
 step, and read poses and joint states.
 """
+import math
 import os
 import tempfile
 
@@ -32,6 +33,8 @@ class SimWorld(object):
             raise RuntimeError('pybullet could not open a %s connection'
                                % ('GUI' if gui else 'DIRECT'))
         self._call = dict(physicsClientId=self.client)
+        if gui:  # building a world while it renders takes many seconds
+            pybullet.configureDebugVisualizer(pybullet.COV_ENABLE_RENDERING, 0, **self._call)
         pybullet.setGravity(0, 0, -GRAVITY, **self._call)
         pybullet.setTimeStep(time_step, **self._call)
         plane_shape = pybullet.createCollisionShape(pybullet.GEOM_PLANE, **self._call)
@@ -51,6 +54,8 @@ class SimWorld(object):
                                 rollingFriction=0.0, spinningFriction=0.0, **self._call)
         self.links = links
         self.set_wheel_speeds(0.0, 0.0)
+        if gui:
+            self._aim_camera(spawn_pose)
         try:
             self._check_spawn_is_clear(spawn_pose)
         except ValueError:
@@ -74,6 +79,15 @@ class SimWorld(object):
                                         yaw_to_quaternion(obstacle.yaw), **self._call)
         pybullet.changeDynamics(body, -1, lateralFriction=GROUND_FRICTION, **self._call)
         return body
+
+    def _aim_camera(self, spawn_pose):
+        """pybullet's window: no side panels, looking over the robot's shoulder, as demo.rviz."""
+        pybullet.configureDebugVisualizer(pybullet.COV_ENABLE_GUI, 0, **self._call)
+        pybullet.configureDebugVisualizer(pybullet.COV_ENABLE_RENDERING, 1, **self._call)
+        x, y, _z, yaw = spawn_pose
+        ahead = [x + 0.5 * math.cos(yaw), y + 0.5 * math.sin(yaw), 0.0]
+        pybullet.resetDebugVisualizerCamera(cameraDistance=3.0, cameraYaw=math.degrees(yaw) - 70.0,
+                                            cameraPitch=-35.0, cameraTargetPosition=ahead, **self._call)
 
     def _check_spawn_is_clear(self, spawn_pose):
         for index, body in enumerate(self.obstacles):

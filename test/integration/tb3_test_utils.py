@@ -1,0 +1,260 @@
+"""Shared helpers of the rostest integration tests (imported, not run).
+
+Everything here is checked against the simulator's ground truth,
+/base_pose_ground_truth: odom is what is under test, never the reference.
+
+Waiting: wall-time deadlines around conditions (sim time can stop, e.g. when
+physics is paused); sim-time durations are waited for as the condition
+"the latest ground-truth stamp has reached t".
+"""
+import atexit
+import ctypes
+import math
+import os
+import signal
+import subprocess
+import tempfile
+import threading
+import time
+from collections import namedtuple
+
+import rospy
+from nav_msgs.msg import Odometry
+
+GROUND_TRUTH = '/base_pose_ground_truth'
+PR_SET_PDEATHSIG = 1
+
+Sample = namedtuple('Sample', 't x y yaw vx vy wz')
+
+
+# --- maths -------------------------------------------------------------------
+def yaw_of(q):
+    """Rotation about z of a geometry_msgs Quaternion."""
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def wrap(angle):
+    """`angle` in [-pi, pi)."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def unwrapped_turn(samples):
+    """Total signed yaw change along `samples` (rad), counting full turns."""
+    return sum(wrap(b.yaw - a.yaw) for a, b in zip(samples, samples[1:]))
+
+
+def in_frame_of(origin, sample):
+    """(x, y) of `sample` in the frame of the pose `origin` (x ahead, y left)."""
+    dx, dy = sample.x - origin.x, sample.y - origin.y
+    c, s = math.cos(origin.yaw), math.sin(origin.yaw)
+    return c * dx + s * dy, -s * dx + c * dy
+
+
+def speed(sample):
+    return math.hypot(sample.vx, sample.vy)
+
+
+def finite_difference_speeds(samples, span=3):
+    """(t, linear speed, yaw rate) from poses `span` samples apart: the truth's own motion."""
+    result = []
+    for a, b in zip(samples, samples[span:]):
+        dt = b.t - a.t
+        if dt > 0:
+            result.append((b.t, math.hypot(b.x - a.x, b.y - a.y) / dt, wrap(b.yaw - a.yaw) / dt))
+    return result
+
+
+def all_finite(message):
+    """True if every float anywhere in a ROS message (recursively) is finite."""
+    if isinstance(message, float):
+        return math.isfinite(message)
+    if isinstance(message, (list, tuple)):
+        return all(all_finite(item) for item in message)
+    slots = getattr(message, '__slots__', None)
+    if slots is None:
+        return True
+    return all(all_finite(getattr(message, slot)) for slot in slots)
+
+
+# --- waiting -----------------------------------------------------------------
+def wait_for(predicate, timeout, poll=0.005):
+    """Poll `predicate` until it is true or `timeout` wall seconds pass; its last value."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = predicate()
+        if value or time.monotonic() >= deadline or rospy.is_shutdown():
+            return value
+        time.sleep(poll)
+
+
+def real_time_factor():
+    """The ~real_time_factor the .test passed on (0 = as fast as possible)."""
+    return float(rospy.get_param('~real_time_factor', 1.0))
+
+
+def wall_budget(sim_seconds, margin=20.0):
+    """Generous wall seconds for `sim_seconds` of simulation on a loaded machine."""
+    factor = real_time_factor()
+    factor = 1.0 if factor <= 0.0 else min(factor, 1.0)
+    return 3.0 * sim_seconds / factor + margin
+
+
+# --- ground truth --------------------------------------------------------------
+class GroundTruth(object):
+    """Every /base_pose_ground_truth message since construction, as Samples."""
+
+    def __init__(self, topic=GROUND_TRUTH):
+        self._lock = threading.Lock()
+        self._samples = []
+        self._sub = rospy.Subscriber(topic, Odometry, self._on_message, queue_size=None)
+
+    def _on_message(self, message):
+        pose, twist = message.pose.pose, message.twist.twist
+        sample = Sample(message.header.stamp.to_sec(), pose.position.x, pose.position.y,
+                        yaw_of(pose.orientation), twist.linear.x, twist.linear.y, twist.angular.z)
+        with self._lock:
+            self._samples.append(sample)
+
+    def samples(self, start=None, end=None):
+        with self._lock:
+            samples = list(self._samples)
+        return [s for s in samples
+                if (start is None or s.t >= start) and (end is None or s.t <= end)]
+
+    def latest(self):
+        with self._lock:
+            return self._samples[-1] if self._samples else None
+
+    def now(self):
+        """Stamp of the latest sample (sim s), or -inf."""
+        latest = self.latest()
+        return latest.t if latest else -math.inf
+
+    def wait_first(self, timeout=60.0):
+        return wait_for(lambda: self.latest() is not None, timeout)
+
+    def wait_until(self, sim_time, timeout):
+        """Wait until a sample stamped at or after `sim_time` has arrived."""
+        return wait_for(lambda: self.now() >= sim_time, timeout)
+
+    def wait_sim(self, duration, timeout=None):
+        """Wait `duration` sim seconds after the latest sample."""
+        return self.wait_until(self.now() + duration,
+                               timeout if timeout is not None else wall_budget(duration))
+
+    def still_since(self, sim_time, tolerance=0.0005, yaw_tolerance=math.radians(0.05)):
+        """True if every sample since `sim_time` is within `tolerance` of the first one."""
+        samples = self.samples(start=sim_time)
+        if len(samples) < 2:
+            return False
+        first = samples[0]
+        return all(math.hypot(s.x - first.x, s.y - first.y) <= tolerance
+                   and abs(wrap(s.yaw - first.yaw)) <= yaw_tolerance for s in samples)
+
+    def wait_at_rest(self, window=0.5, timeout=30.0):
+        """Wait until the robot has not moved for `window` sim seconds; the latest sample or None."""
+        def at_rest():
+            now = self.now()
+            history = self.samples(end=now - window)
+            return bool(history) and self.still_since(now - window)
+        return self.latest() if wait_for(at_rest, timeout, poll=0.02) else None
+
+
+# --- child processes -------------------------------------------------------------
+_libc = ctypes.CDLL(None, use_errno=True)
+_prctl = _libc.prctl
+_children = set()
+_children_lock = threading.Lock()
+
+
+def _die_with_parent():
+    # Runs in the child between fork and exec: if the test node is killed
+    # outright (SIGKILL at rostest's time limit), the kernel kills the child.
+    _prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+
+
+class Child(object):
+    """A command run as the user would run it, in a process group of its own.
+
+    The environment is inherited (ROS_MASTER_URI comes from rostest). Output
+    goes to a log file whose tail `output()` returns for failure messages.
+    """
+
+    def __init__(self, args):
+        self.args = list(args)
+        self._log = tempfile.NamedTemporaryFile(prefix='tb3_child_', suffix='.log', delete=False)
+        self.popen = subprocess.Popen(self.args, stdin=subprocess.DEVNULL, stdout=self._log,
+                                      stderr=subprocess.STDOUT, process_group=0,
+                                      preexec_fn=_die_with_parent)
+        with _children_lock:
+            _children.add(self)
+
+    @property
+    def pid(self):
+        return self.popen.pid
+
+    def running(self):
+        return self.popen.poll() is None
+
+    def signal_group(self, signum):
+        try:
+            os.killpg(self.popen.pid, signum)
+        except ProcessLookupError:
+            pass
+
+    def wait(self, timeout):
+        """Exit code, or None if still running after `timeout` wall seconds."""
+        try:
+            return self.popen.wait(timeout)
+        except subprocess.TimeoutExpired:
+            return None
+
+    def stop(self):
+        """SIGINT, then SIGTERM, then SIGKILL to the whole group, until it is gone."""
+        for signum, grace in ((signal.SIGINT, 5.0), (signal.SIGTERM, 3.0), (signal.SIGKILL, 3.0)):
+            if self.popen.poll() is not None:
+                break
+            self.signal_group(signum)
+            self.wait(grace)
+        # Anything the leader left behind in its group goes too.
+        self.signal_group(signal.SIGKILL)
+        self.popen.poll()
+        with _children_lock:
+            _children.discard(self)
+
+    def output(self, tail=3000):
+        try:
+            with open(self._log.name, 'rb') as log:
+                text = log.read().decode('utf-8', 'replace')
+        except OSError:
+            return ''
+        return text[-tail:]
+
+    def describe(self):
+        return '%s (exit %r), output:\n%s' % (' '.join(self.args), self.popen.poll(), self.output())
+
+
+def stop_all_children():
+    with _children_lock:
+        children = list(_children)
+    for child in children:
+        child.stop()
+
+
+atexit.register(stop_all_children)
+
+
+def init_test_node(name):
+    """rospy.init_node, and every child process stopped when the node shuts down."""
+    rospy.init_node(name)
+    rospy.on_shutdown(stop_all_children)
+
+
+def report(name, **values):
+    """A line of measured numbers, easy to grep from the test output."""
+    text = ', '.join('%s=%s' % (key, ('%.4f' % value) if isinstance(value, float) else value)
+                     for key, value in sorted(values.items()))
+    line = 'MEASURED %s: %s' % (name, text)
+    print(line, flush=True)
+    rospy.loginfo(line)
+    return line

@@ -1,0 +1,325 @@
+#!/usr/bin/env python3
+"""rviz with the tutorial's demo.rviz, on a screen of its own, shows what the learner must see.
+
+The .test includes tb3_world.launch (arena, pillars, spawn at (-2, -0.5)). This
+node starts Xvfb on a free display (Xvfb picks it: -displayfd) and rviz as the
+tutorial does (`rosrun rviz rviz -d \`rospack find tb3_sim_bringup\`/rviz/demo.rviz`),
+polls screenshots of the root window until the 3D view shows the robot and the
+scan, then checks one screenshot after a settling time:
+
+- the 3D view is not blank (many colours, non-trivial variance);
+- the robot is there (its orange lidar, the URDF's only orange);
+- the scan is there (the LaserScan display's flat colour, read from demo.rviz);
+- no display is in Error or Warn state (see ERROR_COLOURS for how);
+- driving the tutorial's circle adds red /odom arrows to the trail.
+
+Screenshots: `import -window root -depth 8 ppm:-` (imagemagick, a listed apt
+package), decoded with numpy, so no imaging library is needed; the last run's
+are kept in ~/.ros/test_results/tb3_sim_nav/rviz_renders/. rviz and Xvfb are
+stopped by process group (their PIDs) as soon as the screenshots are taken,
+in a `finally` (so also on failure), at rospy shutdown and at exit;
+PR_SET_PDEATHSIG kills them if this node is killed outright.
+
+Parameter ~rviz_config: the configuration under test (default: the
+tutorial's demo.rviz); `rostest tb3_sim_nav rviz_renders.test
+rviz_config:=/path/to/other.rviz` shows that a broken one fails.
+"""
+import os
+import re
+import subprocess
+import time
+import unittest
+
+import numpy
+import rospkg
+import rospy
+import rostest
+import yaml
+from geometry_msgs.msg import Twist
+
+from tb3_test_utils import Child, init_test_node, report, wait_for
+
+SCREEN = (1280, 800)
+RENDER_TIMEOUT = 90.0     # wall s from rviz's start to a 3D view with robot and scan
+SETTLE = 3.0              # wall s after that for transient start-up statuses to clear
+DRIVE_SECONDS = 6.0       # wall s of the tutorial's circle command
+MIN_COLOURS = 50          # distinct colours in the 3D view (a blank view has 1-3)
+MIN_STDDEV = 5.0          # standard deviation of the 3D view's channel values
+MIN_ROBOT_PIXELS = 40     # orange pixels of the lidar (about 200 at the spawn pose)
+MIN_SCAN_PIXELS = 1000    # scan-coloured pixels (several thousand in the arena)
+MIN_NEW_TRAIL_PIXELS = 100  # red arrow pixels added by DRIVE_SECONDS of driving
+MIN_NAME_PIXELS = 100     # display names in rviz's "enabled, OK" blue: the panel is there
+COLOUR_TOLERANCE = 12     # per channel, for the exact colours below
+
+# How "no display shows an error" is checked. rviz reports a display's status
+# only in its Displays panel: a display in Error state gets a red icon and its
+# name drawn in StatusProperty's error colour, (192, 32, 32); Warn in
+# (192, 128, 0); an enabled display that is OK has its name in (40, 120, 197).
+# Nothing of it reaches stderr or /rosout (checked: a RobotModel whose
+# robot_description parameter does not exist turns red in the panel and
+# prints nothing), so reading rviz's output alone would miss it. The panel's
+# pixels are the one reliable source: the left dock (everything left of the 3D
+# view) must hold none of the two status colours, and must hold the OK blue,
+# or we would be looking at the wrong place. rviz's output is checked as
+# well, for [ERROR] lines (a plugin's ROS_ERROR, a bad URDF).
+ERROR_COLOURS = {'Error': (192, 32, 32), 'Warn': (192, 128, 0)}
+OK_NAME_COLOUR = (40, 120, 197)
+ROBOT_ORANGE_MIN_RED = 120  # lit orange: red high, green about half of it, little blue
+
+CIRCLE = Twist()
+CIRCLE.linear.x, CIRCLE.angular.z = 0.1, -0.5
+
+
+# --- screenshots -------------------------------------------------------------
+def read_ppm(data):
+    """A binary PPM (P6, maxval 255) as an H x W x 3 int array."""
+    fields, position = [], 0
+    while len(fields) < 4:
+        match = re.compile(rb'\s*(#[^\n]*\n\s*)*(\S+)').match(data, position)
+        fields.append(match.group(2))
+        position = match.end()
+    if fields[0] != b'P6' or int(fields[3]) != 255:
+        raise ValueError('not an 8-bit binary PPM: %r' % fields)
+    width, height = int(fields[1]), int(fields[2])
+    pixels = numpy.frombuffer(data, numpy.uint8, width * height * 3, position + 1)
+    return pixels.reshape(height, width, 3).astype(int)
+
+
+def screenshot(display):
+    data = subprocess.run(['import', '-display', display, '-window', 'root', '-depth', '8', 'ppm:-'],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=30, check=True).stdout
+    return read_ppm(data)
+
+
+def save_png(image, path):
+    subprocess.run(['convert', 'ppm:-', path], input=b'P6 %d %d 255\n' % image.shape[1::-1]
+                   + image.astype(numpy.uint8).tobytes(), check=True, timeout=30)
+
+
+def near(image, colour, tolerance=COLOUR_TOLERANCE):
+    """Boolean mask of the pixels within `tolerance` of `colour` on every channel."""
+    return (numpy.abs(image - numpy.array(colour)).max(axis=2) <= tolerance)
+
+
+def longest_run(flags):
+    """(start, stop) of the longest run of True in a 1-D boolean array, or None."""
+    best, start = None, None
+    for index, flag in enumerate(list(flags) + [False]):
+        if flag and start is None:
+            start = index
+        elif not flag and start is not None:
+            if best is None or index - start > best[1] - best[0]:
+                best = (start, index)
+            start = None
+    return best
+
+
+def find_3d_view(image, background):
+    """(top, bottom, left, right) of the 3D view: the largest block of rows and
+    columns mostly in the configured background colour, or None."""
+    mask = near(image, background, 2)
+    columns = longest_run(mask.mean(axis=0) > 0.3)
+    rows = longest_run(mask.mean(axis=1) > 0.3)
+    if columns is None or rows is None or columns[1] - columns[0] < 200 or rows[1] - rows[0] < 200:
+        return None
+    return rows[0], rows[1], columns[0], columns[1]
+
+
+class Frame(object):
+    """One screenshot cut into what the checks look at."""
+
+    def __init__(self, image, config):
+        self.image = image
+        self.view_box = find_3d_view(image, config.background)
+        if self.view_box is None:
+            self.view = self.panel = None
+            return
+        top, bottom, left, right = self.view_box
+        self.view = image[top:bottom, left:right]
+        self.panel = image[top:bottom, :left]  # the left dock: Displays (and Views)
+
+    @property
+    def rendered(self):
+        return self.view is not None
+
+    def colours(self):
+        return len(numpy.unique(self.view.reshape(-1, 3), axis=0))
+
+    def stddev(self):
+        return float(self.view.std())
+
+    def scan_pixels(self, config):
+        return int(near(self.view, config.scan_colour, 30).sum())
+
+    def robot_pixels(self):
+        r, g, b = self.view[..., 0], self.view[..., 1], self.view[..., 2]
+        return int(((r >= ROBOT_ORANGE_MIN_RED) & (g > 0.3 * r) & (g < 0.7 * r) & (b < 0.3 * r)).sum())
+
+    def trail_pixels(self):
+        """Red of the /odom arrows (and of the TF x axes, a constant)."""
+        r, g, b = self.view[..., 0], self.view[..., 1], self.view[..., 2]
+        return int(((r > 120) & (g < 0.25 * r) & (b < 0.25 * r)).sum())
+
+    def status_pixels(self):
+        return dict((name, int(near(self.panel, colour).sum())) for name, colour in ERROR_COLOURS.items())
+
+    def ok_name_pixels(self):
+        return int(near(self.panel, OK_NAME_COLOUR).sum())
+
+    def shows_robot_and_scan(self, config):
+        return (self.rendered and self.colours() >= MIN_COLOURS
+                and self.robot_pixels() >= MIN_ROBOT_PIXELS and self.scan_pixels(config) >= MIN_SCAN_PIXELS)
+
+
+class RvizConfig(object):
+    """The colours the checks need, read from demo.rviz itself."""
+
+    def __init__(self, path):
+        with open(path) as stream:
+            config = yaml.safe_load(stream)
+        manager = config['Visualization Manager']
+        self.background = self._colour(manager['Global Options']['Background Color'])
+        displays = dict((display['Class'], display) for display in manager['Displays'])
+        self.displays = sorted(displays)
+        scan = displays['rviz/LaserScan']
+        if scan.get('Color Transformer') != 'FlatColor':
+            raise ValueError('the test finds the scan by its flat colour; demo.rviz uses %r'
+                             % scan.get('Color Transformer'))
+        self.scan_colour = self._colour(scan['Color'])
+        self.fixed_frame = manager['Global Options']['Fixed Frame']
+
+    @staticmethod
+    def _colour(text):
+        return tuple(int(part) for part in str(text).split(';'))
+
+
+# --- processes -----------------------------------------------------------------
+def start_xvfb():
+    """Xvfb on a display it picks itself (-displayfd 1 prints the number): (Child, ':N')."""
+    xvfb = Child(['Xvfb', '-displayfd', '1', '-screen', '0', '%dx%dx24' % SCREEN, '-nolisten', 'tcp'])
+    number = wait_for(lambda: re.search(r'^(\d+)$', xvfb.output(), re.M) or not xvfb.running(), 20.0, 0.05)
+    if not number or not xvfb.running():
+        description = xvfb.describe()
+        xvfb.stop()
+        raise AssertionError('Xvfb did not start: %s' % description)
+    return xvfb, ':' + number.group(1)
+
+
+class RvizRenders(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.xvfb = cls.rviz = None
+        cls.setup_error = None
+        cls.frame = cls.driven = None
+        cls.not_rendered = ''
+        # The latest run's screenshots, overwritten by the next run.
+        cls.shots = os.path.join(rospkg.get_ros_home(), 'test_results', 'tb3_sim_nav', 'rviz_renders')
+        os.makedirs(cls.shots, exist_ok=True)
+        started = time.monotonic()
+        try:
+            cls._run()
+        except Exception as error:  # reported by every test, with its cause
+            cls.setup_error = '%s: %s' % (type(error).__name__, error)
+        finally:
+            cls.rviz_output = cls.rviz.output(20000) if cls.rviz else ''
+            for child in (cls.rviz, cls.xvfb):
+                if child is not None:
+                    child.stop()
+        report('rviz_renders', wall_seconds=time.monotonic() - started, screenshots=cls.shots)
+
+    @classmethod
+    def _run(cls):
+        path = rospy.get_param('~rviz_config', '') or os.path.join(
+            rospkg.RosPack().get_path('tb3_sim_bringup'), 'rviz', 'demo.rviz')
+        cls.config = RvizConfig(path)
+        cls.xvfb, display = start_xvfb()
+        os.environ['DISPLAY'] = display  # rviz inherits it (Child passes the environment on)
+        cls.rviz = Child(['rosrun', 'rviz', 'rviz', '-d', path])
+        started = time.monotonic()
+        frames = []
+
+        def rendered():
+            if not cls.rviz.running():
+                raise AssertionError('rviz exited: %s' % cls.rviz.describe())
+            frames[:] = [Frame(screenshot(display), cls.config)]
+            return frames[0].shows_robot_and_scan(cls.config)
+        if not wait_for(rendered, RENDER_TIMEOUT, poll=1.0):
+            # Each test then judges this last screenshot and says what is missing.
+            cls.frame = frames[0]
+            cls.not_rendered = ('; rviz showed no robot and scan within %.0f s; rviz output:\n%s'
+                                % (RENDER_TIMEOUT, cls.rviz.output()))
+            save_png(cls.frame.image, os.path.join(cls.shots, 'not_rendered.png'))
+            return
+        cls.render_seconds = time.monotonic() - started
+        time.sleep(SETTLE)
+        cls.frame = Frame(screenshot(display), cls.config)
+        save_png(cls.frame.image, os.path.join(cls.shots, 'settled.png'))
+
+        # The tutorial's circle, published from here at 10 Hz: the trail grows.
+        publisher = rospy.Publisher('/cmd_vel', Twist, queue_size=1)
+        wait_for(lambda: publisher.get_num_connections() > 0, 10.0)
+        end = time.monotonic() + DRIVE_SECONDS
+        while time.monotonic() < end and not rospy.is_shutdown():
+            publisher.publish(CIRCLE)
+            time.sleep(0.1)
+        publisher.publish(Twist())
+        time.sleep(1.0)
+        cls.driven = Frame(screenshot(display), cls.config)
+        save_png(cls.driven.image, os.path.join(cls.shots, 'driven.png'))
+        report('rviz_renders_frame', render_seconds=cls.render_seconds, colours=cls.frame.colours(),
+               stddev=cls.frame.stddev(), robot_pixels=cls.frame.robot_pixels(),
+               scan_pixels=cls.frame.scan_pixels(cls.config), trail_pixels_before=cls.frame.trail_pixels(),
+               trail_pixels_after=cls.driven.trail_pixels(), ok_name_pixels=cls.frame.ok_name_pixels(),
+               **dict(('%s_pixels' % name.lower(), count)
+                      for name, count in cls.frame.status_pixels().items()))
+
+    def setUp(self):
+        if self.setup_error:
+            self.fail(self.setup_error)
+
+    def where(self):
+        return ' (screenshots in %s)%s' % (self.shots, self.not_rendered)
+
+    def rendered_frame(self):
+        self.assertTrue(self.frame.rendered, 'no 3D view (no block of the background colour %s) '
+                        'in the screenshot%s' % (self.config.background, self.where()))
+        return self.frame
+
+    def test_3d_view_is_not_blank(self):
+        frame = self.rendered_frame()
+        self.assertGreaterEqual(frame.colours(), MIN_COLOURS, 'colours in the 3D view' + self.where())
+        self.assertGreaterEqual(frame.stddev(), MIN_STDDEV, 'variance of the 3D view' + self.where())
+
+    def test_robot_model_is_visible(self):
+        self.assertGreaterEqual(self.rendered_frame().robot_pixels(), MIN_ROBOT_PIXELS,
+                                'the robot (its orange lidar) is not in the 3D view' + self.where())
+
+    def test_scan_is_visible(self):
+        self.assertGreaterEqual(self.rendered_frame().scan_pixels(self.config), MIN_SCAN_PIXELS,
+                                'too few pixels of the scan colour %s in the 3D view%s'
+                                % (self.config.scan_colour, self.where()))
+
+    def test_no_display_in_error_or_warn_state(self):
+        self.rendered_frame()
+        for frame, when in ((self.frame, 'after start-up'), (self.driven, 'after driving')):
+            if frame is None:
+                continue
+            self.assertGreaterEqual(frame.ok_name_pixels(), MIN_NAME_PIXELS,
+                                    'no display names in the Displays panel %s%s' % (when, self.where()))
+            self.assertEqual(frame.status_pixels(), dict((name, 0) for name in ERROR_COLOURS),
+                             'a display shows an error or warning status %s%s' % (when, self.where()))
+
+    def test_rviz_prints_no_error(self):
+        errors = [line for line in self.rviz_output.splitlines() if '[ERROR]' in line]
+        self.assertEqual(errors, [], 'rviz printed errors')
+
+    def test_odometry_trail_grows_when_driving(self):
+        self.assertIsNotNone(self.driven, 'the robot was not driven' + self.where())
+        added = self.driven.trail_pixels() - self.frame.trail_pixels()
+        self.assertGreaterEqual(added, MIN_NEW_TRAIL_PIXELS,
+                                'driving added only %d red pixels of /odom arrows%s' % (added, self.where()))
+
+
+if __name__ == '__main__':
+    init_test_node('test_rviz_renders')
+    rostest.rosrun('tb3_sim_nav', 'rviz_renders', RvizRenders)
