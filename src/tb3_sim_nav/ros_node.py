@@ -114,6 +114,7 @@ class SimulatorNode(object):
     def _make_messages(self):
         """Messages reused every publication: only stamps and values change."""
         frame, child = self.config['odom_frame'], self.config['base_frame']
+        self._clock = Clock(clock=rospy.Time(0, 0))
         self._odom = Odometry()
         self._odom.header.frame_id = frame
         self._odom.child_frame_id = child
@@ -224,9 +225,12 @@ class SimulatorNode(object):
             self.sim.command(v, w)
             self._applied_count = count
         self.sim.step()
+        # One stamp object for the whole step: publishing is synchronous, so
+        # every message is serialised before the next step changes it.
+        stamp = self._clock.clock
+        stamp.secs, stamp.nsecs = divmod(self.sim.now_ns, 1000000000)
         now_ns = self.sim.now_ns
-        stamp = rospy.Time(now_ns // 1000000000, now_ns % 1000000000)
-        self.clock_pub.publish(Clock(clock=stamp))
+        self.clock_pub.publish(self._clock)
         due = self._due
         if due['odom'].due(now_ns):
             self.publish_odometry(stamp)

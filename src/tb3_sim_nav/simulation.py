@@ -53,8 +53,14 @@ class Simulation(object):
         self.encoder_odometry.reset(x, y, yaw)
 
     def command(self, v, w):
-        """A sanitised body command (m/s, rad/s), taking effect at the next step."""
-        self._target = wheel_speeds(v, w, *self.geometry)
+        """A sanitised body command (m/s, rad/s), taking effect at the next step.
+
+        The motors reach their speed only to within their errors: timing
+        alone cannot know that, encoders can.
+        """
+        left, right = wheel_speeds(v, w, *self.geometry)
+        self._target = (left * (1.0 + self.config['left_motor_error']),
+                        right * (1.0 + self.config['right_motor_error']))
         self._last_command_ns = self.now_ns
 
     def _motor_speeds(self):
@@ -78,6 +84,8 @@ class Simulation(object):
             self._wheels = speeds
         self.world.step()
         self.steps += 1
+        if self.config['odom_source'] == 'encoders':
+            self._read_encoders()
 
     def reset_world(self):
         """Robot back to its spawn pose and at rest, odometry zeroed; time runs on."""
@@ -96,16 +104,21 @@ class Simulation(object):
         """Position (x, y, z) and orientation (x, y, z, w) of base_footprint."""
         return self.world.base_pose()
 
-    def odometry_pose(self):
-        """The pose odom reports: the true one (Gazebo) or the encoders' dead reckoning."""
-        if self.config['odom_source'] == 'world':
-            return self.true_pose()
+    def _read_encoders(self):
+        """Dead reckoning, every step as the firmware integrates every cycle."""
         angles, _ = self.world.wheel_states()
         noise = self.config['encoder_noise']
         if noise > 0.0:
             angles = np.asarray(angles) + self._rng.normal(0.0, noise, 2)
-        x, y, yaw = self.encoder_odometry.update(*angles)
-        return (x, y, 0.0), (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
+        self.encoder_odometry.update(*angles)
+
+    def odometry_pose(self):
+        """The pose odom reports: the true one (Gazebo) or the encoders' dead reckoning."""
+        if self.config['odom_source'] == 'world':
+            return self.true_pose()
+        odometry = self.encoder_odometry
+        return ((odometry.x, odometry.y, 0.0),
+                (0.0, 0.0, math.sin(odometry.yaw / 2.0), math.cos(odometry.yaw / 2.0)))
 
     def true_twist(self):
         """Body-frame linear and angular velocity of base_footprint."""

@@ -6,7 +6,7 @@
   hztest on /tf would count its wheel transforms too);
 - /clock never goes backwards and never publishes zero;
 - /clock is fine-grained: at least 95 % of its messages advance exactly one
-  physics step (1/200 s), so that a 50 Hz rospy.Rate (timed_out_and_back.py)
+  physics step (1/100 s), so that a 50 Hz rospy.Rate (timed_out_and_back.py)
   keeps its rate in sim time. (A rospy publisher drops messages when its
   queue overflows on a loaded machine, so the odd larger step is allowed;
   the largest is reported.)
@@ -77,7 +77,7 @@ class TfRateAndClock(unittest.TestCase):
     def test_clock_never_goes_backwards(self):
         backwards = [(a.to_sec(), b.to_sec()) for a, b in zip(self.clock_values, self.clock_values[1:])
                      if b < a]
-        self.assertGreater(len(self.clock_values), 1000)
+        self.assertGreater(len(self.clock_values), 500)
         self.assertEqual(backwards, [], '/clock went backwards')
 
     def test_clock_never_publishes_zero(self):
@@ -85,11 +85,11 @@ class TfRateAndClock(unittest.TestCase):
         self.assertEqual(zeros, 0, '/clock published zero %d times' % zeros)
 
     def test_clock_advances_one_physics_step_per_message(self):
-        step = 1.0 / 200
+        step = 1.0 / 100
         steps = [(b - a).to_sec() for a, b in zip(self.clock_values, self.clock_values[1:])]
         other = [s for s in steps if not math.isclose(s, step, abs_tol=1e-6)]
         report('clock', messages=len(self.clock_values), min_step_s=min(steps),
-               max_step_s=max(steps), steps_not_5ms=len(other))
+               max_step_s=max(steps), steps_not_one_step=len(other))
         self.assertLessEqual(len(other), 0.05 * len(steps),
                              '%d of %d /clock steps are not one physics step (%g s): %s'
                              % (len(other), len(steps), step, other[:10]))

@@ -28,7 +28,7 @@ def test_defaults_resolve(resolve_with, burger_urdf):
             expected = parameter.default
         assert config[parameter.name] == expected
         assert type(config[parameter.name]) is parameter.kind
-    assert config['real_time_factor'] == 1.0 and config['physics_rate'] == 200.0
+    assert config['real_time_factor'] == 1.0 and config['physics_rate'] == 100.0
     assert config['odom_frame'] == 'odom' and config['base_frame'] == 'base_footprint'
 
 
@@ -91,7 +91,7 @@ def test_odom_rate_equal_to_physics_rate_is_fine(resolve_with):
 
 def test_a_sensor_rate_above_the_physics_rate_is_refused(resolve_with):
     with pytest.raises(ParameterError, match='~imu_rate = 200.0: must not exceed ~physics_rate'):
-        resolve_with(physics_rate=100.0)
+        resolve_with(physics_rate=100.0, imu_rate=200.0)
 
 
 def test_the_realistic_profile_sets_its_knobs(resolve_with):

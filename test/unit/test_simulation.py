@@ -10,7 +10,7 @@ from tb3_sim_nav.robot_model import read_drive_geometry
 from tb3_sim_nav.simulation import Simulation
 from tb3_sim_nav.world_file import load_world
 
-RATE = 200  # physics_rate default
+RATE = 100  # physics_rate default
 COMMAND_EVERY = 20  # steps: `rostopic pub -r 10`
 ODOM_EVERY = 7      # steps: odom at ~30 Hz, as the node reads it
 
