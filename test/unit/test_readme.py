@@ -53,3 +53,11 @@ def test_the_readme_shows_the_two_commands_and_the_tutorials_commands():
 def test_the_ci_script_runs_the_readmes_test_command():
     with open(os.path.join(ROOT, '.ci', 'run')) as ci:
         assert 'make test' in ci.read()
+
+
+def test_the_readme_parameter_table_is_the_generated_one():
+    import subprocess
+    import sys
+    table = subprocess.run([sys.executable, os.path.join(ROOT, 'tools', 'params_table.py')],
+                           stdout=subprocess.PIPE, universal_newlines=True, check=True).stdout
+    assert table.strip() in _readme()

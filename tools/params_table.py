@@ -1,0 +1,30 @@
+"""Prints the README's table of the simulator's parameters, from params.py."""
+import os
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src'))
+from tb3_sim_nav.params import PARAMETERS, PROFILES  # noqa: E402
+
+
+def shown(value):
+    if isinstance(value, bool):
+        return 'true' if value else 'false'
+    return '`%s`' % value if isinstance(value, str) else repr(value)
+
+
+def main():
+    print('| parameter | default | unit | meaning |')
+    print('|---|---|---|---|')
+    for parameter in PARAMETERS:
+        if parameter.name == 'urdf_file':
+            default = '(set by the launch)'
+        elif parameter.default is None:
+            default = ', '.join('%s: %s' % (profile, shown(PROFILES[profile][parameter.name]))
+                                for profile in sorted(PROFILES))
+        else:
+            default = shown(parameter.default)
+        print('| `~%s` | %s | %s | %s |' % (parameter.name, default, parameter.unit, parameter.doc))
+
+
+if __name__ == '__main__':
+    main()
