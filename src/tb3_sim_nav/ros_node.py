@@ -85,8 +85,6 @@ class SimulatorNode(object):
         self._command = (0.0, 0.0, 0)  # v, w, count of commands received
         self._applied_count = 0
         self._hold_until = 0.0
-        self._echo_ns = 0
-        self._echo = threading.Condition()
         self._max_lead_ns = int(round(config['max_clock_lead'] * 1e9))
         self._make_schedules()
         self._make_messages()
@@ -98,10 +96,8 @@ class SimulatorNode(object):
         self.scan_pub = _publisher('scan', LaserScan) if simulation.lidar else None
         self.imu_pub = _publisher('imu', Imu) if simulation.imu else None
         rospy.Subscriber('cmd_vel', Twist, self._on_cmd_vel, queue_size=10, tcp_nodelay=True)
-        # Faster than real time only: listen to our own /clock (see _wait_for_echo).
-        self._echoing = not 0.0 < config['real_time_factor'] <= 1.0
-        if self._echoing:
-            rospy.Subscriber('clock', Clock, self._on_clock_echo, queue_size=1, tcp_nodelay=True)
+        # Faster than real time, and only if rospy follows /clock here as in every node.
+        self._echoing = (not 0.0 < config['real_time_factor'] <= 1.0) and not rospy.rostime.is_wallclock()
         for name, handler in (('pause_physics', self._on_pause), ('unpause_physics', self._on_unpause),
                               ('reset_world', self._on_reset_world),
                               ('reset_simulation', self._on_reset_simulation)):
@@ -162,26 +158,24 @@ class SimulatorNode(object):
         lost to connection set-up, which takes wall time, not sim time."""
         self._hold_until = time.monotonic() + self.config['startup_hold']
 
-    def _on_clock_echo(self, message):
-        with self._echo:
-            self._echo_ns = message.clock.to_nsec()
-            self._echo.notify()
-
     def _wait_for_echo(self, now_ns):
-        """Hold the next step until our own /clock subscriber has seen `now_ns - lead`.
+        """Hold the next step until rospy's own /clock subscriber in this node
+        has seen `now_ns - lead`.
 
         Faster than real time, every other node lags behind /clock by its
         delivery and processing time, and a command it sends arrives that much
-        sim time late. Waiting for a python subscriber of our own bounds that
-        lag in sim time whatever the factor.
+        sim time late. Waiting for a python subscriber of our own (as slow as
+        theirs) bounds that lag in sim time whatever the factor.
         """
         deadline = time.monotonic() + ECHO_TIMEOUT
-        with self._echo:
-            while self._echo_ns < now_ns - self._max_lead_ns and not rospy.is_shutdown():
+        echoed = rospy.rostime.get_rostime_cond()
+        with echoed:
+            while (rospy.rostime.get_rostime().to_nsec() < now_ns - self._max_lead_ns
+                   and not rospy.is_shutdown()):
                 remaining = deadline - time.monotonic()
                 if remaining <= 0.0:
                     return
-                self._echo.wait(remaining)
+                echoed.wait(remaining)
 
     def _on_pause(self, _request):
         self.pacer.pause()
@@ -200,8 +194,6 @@ class SimulatorNode(object):
     def _on_reset_simulation(self, _request):
         with self._lock:
             self.sim.reset_simulation()
-            with self._echo:
-                self._echo_ns = 0
             self.pacer.restart()
         rospy.loginfo('reset_simulation: robot back at its spawn pose, time back to zero')
         return EmptyResponse()
