@@ -63,6 +63,17 @@ def _publisher(topic, message_class, **options):
         return rospy.Publisher(topic, message_class, queue_size=None, tcp_nodelay=True, **options)
 
 
+def _stop_following_clock():
+    """Under sim time rospy subscribes every node to /clock, this one too:
+    here that would send every tick through a socket back to where it came
+    from. Drop that subscription (True); the step loop sets rospy's time."""
+    from rospy.impl import simtime
+    if rospy.rostime.is_wallclock() or simtime._clock_sub is None:
+        return False
+    simtime._clock_sub.unregister()
+    return True
+
+
 class _OnSubscribe(rospy.SubscribeListener):
     def __init__(self, callback):
         super(_OnSubscribe, self).__init__()
@@ -96,8 +107,13 @@ class SimulatorNode(object):
         self.scan_pub = _publisher('scan', LaserScan) if simulation.lidar else None
         self.imu_pub = _publisher('imu', Imu) if simulation.imu else None
         rospy.Subscriber('cmd_vel', Twist, self._on_cmd_vel, queue_size=10, tcp_nodelay=True)
-        # Faster than real time, and only if rospy follows /clock here as in every node.
-        self._echoing = (not 0.0 < config['real_time_factor'] <= 1.0) and not rospy.rostime.is_wallclock()
+        self._own_clock = _stop_following_clock()
+        # Faster than real time, listen to our own /clock (see _wait_for_echo).
+        self._echo_ns = 0
+        self._echo = threading.Condition()
+        self._echoing = not 0.0 < config['real_time_factor'] <= 1.0
+        if self._echoing:
+            rospy.Subscriber('clock', Clock, self._on_clock_echo, queue_size=1, tcp_nodelay=True)
         for name, handler in (('pause_physics', self._on_pause), ('unpause_physics', self._on_unpause),
                               ('reset_world', self._on_reset_world),
                               ('reset_simulation', self._on_reset_simulation)):
@@ -158,9 +174,13 @@ class SimulatorNode(object):
         lost to connection set-up, which takes wall time, not sim time."""
         self._hold_until = time.monotonic() + self.config['startup_hold']
 
+    def _on_clock_echo(self, message):
+        with self._echo:
+            self._echo_ns = message.clock.to_nsec()
+            self._echo.notify()
+
     def _wait_for_echo(self, now_ns):
-        """Hold the next step until rospy's own /clock subscriber in this node
-        has seen `now_ns - lead`.
+        """Hold the next step until our own /clock subscriber has seen `now_ns - lead`.
 
         Faster than real time, every other node lags behind /clock by its
         delivery and processing time, and a command it sends arrives that much
@@ -168,14 +188,12 @@ class SimulatorNode(object):
         theirs) bounds that lag in sim time whatever the factor.
         """
         deadline = time.monotonic() + ECHO_TIMEOUT
-        echoed = rospy.rostime.get_rostime_cond()
-        with echoed:
-            while (rospy.rostime.get_rostime().to_nsec() < now_ns - self._max_lead_ns
-                   and not rospy.is_shutdown()):
+        with self._echo:
+            while self._echo_ns < now_ns - self._max_lead_ns and not rospy.is_shutdown():
                 remaining = deadline - time.monotonic()
                 if remaining <= 0.0:
                     return
-                echoed.wait(remaining)
+                self._echo.wait(remaining)
 
     def _on_pause(self, _request):
         self.pacer.pause()
@@ -194,6 +212,8 @@ class SimulatorNode(object):
     def _on_reset_simulation(self, _request):
         with self._lock:
             self.sim.reset_simulation()
+            with self._echo:
+                self._echo_ns = 0
             self.pacer.restart()
         rospy.loginfo('reset_simulation: robot back at its spawn pose, time back to zero')
         return EmptyResponse()
@@ -225,6 +245,8 @@ class SimulatorNode(object):
         self.clock_pub.publish(self._clock)
         due = self._due
         if due['odom'].due(now_ns):
+            if self._own_clock:  # the stamps of our log messages need be no finer
+                rospy.rostime._set_rostime(stamp)
             self.publish_odometry(stamp)
         if due['joint_states'].due(now_ns):
             self.publish_joint_states(stamp)
