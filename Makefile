@@ -6,7 +6,7 @@ WS := .ws
 PYTHON := $(CURDIR)/$(VENV)/bin/python3
 IN_ROS := source setup.bash &&
 
-.PHONY: setup apt demo test unit integration lint bench soak clean
+.PHONY: setup apt demo test unit integration lint bench soak speed-agreement clean
 
 setup: apt $(VENV)/.ready $(WS)/devel/.ready
 
@@ -48,6 +48,9 @@ lint: setup
 
 bench: setup
 	$(IN_ROS) python3 tools/bench.py $(BENCH_ARGS)
+
+speed-agreement: setup
+	$(IN_ROS) python3 -m pytest -q -s -p no:cacheprovider test/system/test_speed_agreement.py
 
 soak: setup
 	$(IN_ROS) python3 tools/soak.py --check

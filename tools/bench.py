@@ -174,7 +174,9 @@ def main(argv=None):
     parser.add_argument('--runs', type=int, default=3, help='runs per figure (median reported)')
     parser.add_argument('--seconds', type=float, default=10.0, help='wall s per real-time-factor run')
     parser.add_argument('--cpu-seconds', type=float, default=30.0, help='wall s of the CPU measurement')
-    parser.add_argument('--skip-scripts', action='store_true', help='leave out the tutorial scripts')
+    parser.add_argument('--parts', default='rtf,cpu,scripts',
+                        help='comma-separated: rtf (max real-time factor), cpu (CPU, memory, start-up), '
+                             'scripts (the tutorial scripts at factor 1 and 0); default all')
     parser.add_argument('--output', default=os.path.join(demo.ROOT, 'bench_output'))
     args = parser.parse_args(argv)
     log_dir = os.path.join(args.output, 'logs')
@@ -185,8 +187,9 @@ def main(argv=None):
         master = demo.start_master(log_dir)
         import rospy
         rospy.init_node('tb3_bench', anonymous=True, argv=[sys.argv[0]], disable_signals=True)
+        parts = args.parts.split(',')
         rtf, rss = {}, []
-        for label, params in SENSOR_SETS:
+        for label, params in (SENSOR_SETS if 'rtf' in parts else []):
             rtf[label] = []
             for run in range(args.runs):
                 value, peak = measure_rtf(log_dir, params, args.seconds)
@@ -194,32 +197,35 @@ def main(argv=None):
                 rtf[label].append(value)
                 rss.append(peak)
         cpu, startup = [], []
-        for run in range(args.runs):
+        for run in range(args.runs if 'cpu' in parts else 0):
             used, peak, started = measure_cpu_and_startup(log_dir, args.cpu_seconds)
             say('factor 1 while driving, run %d: %.1f %% of a core, start-up %.2f s' % (run + 1, used, started))
             cpu.append(used)
             rss.append(peak)
             startup.append(started)
         scripts = {}
-        if not args.skip_scripts:
+        if 'scripts' in parts:
             for factor in (1.0, 0.0):
                 scripts[factor] = run_scripts(log_dir, factor)
 
-        full = median(rtf['every topic on'])
         lines += ['tb3_sim_nav benchmark, %s' % datetime.date.today().isoformat(),
                   'machine: %s' % machine(),
                   'medians of %d runs; real-time factor = sim seconds per wall second' % args.runs, '',
-                  '%-58s %12s  %s' % ('figure', 'value', 'target'),
-                  '%-58s %12.1f  >= %g: %s' % ('max real-time factor, headless empty world, every topic on',
-                                              full, TARGETS['rtf'], verdict(full >= TARGETS['rtf']))]
-        for label, _ in SENSOR_SETS[1:]:
-            lines.append('%-58s %12.1f' % ('max real-time factor, ' + label, median(rtf[label])))
-        lines += ['%-58s %11.1f%%  < %g %%: %s' % ('CPU of the simulator at factor 1, driving (% of a core)',
-                                                   median(cpu), TARGETS['cpu'], verdict(median(cpu) < TARGETS['cpu'])),
-                  '%-58s %8.0f MiB' % ('peak RSS of the simulator node (max over runs)', max(rss)),
-                  '%-58s %10.2f s  < %g s: %s' % ('start-up: roslaunch to first odom->base_footprint',
-                                                  median(startup), TARGETS['startup'],
-                                                  verdict(median(startup) < TARGETS['startup']))]
+                  '%-58s %12s  %s' % ('figure', 'value', 'target')]
+        if rtf:
+            full = median(rtf['every topic on'])
+            lines.append('%-58s %12.1f  >= %g: %s' % ('max real-time factor, headless empty world, every topic on',
+                                                     full, TARGETS['rtf'], verdict(full >= TARGETS['rtf'])))
+            for label, _ in SENSOR_SETS[1:]:
+                lines.append('%-58s %12.1f' % ('max real-time factor, ' + label, median(rtf[label])))
+        if cpu:
+            lines += ['%-58s %11.1f%%  < %g %%: %s' % ('CPU of the simulator at factor 1, driving (% of a core)',
+                                                       median(cpu), TARGETS['cpu'], verdict(median(cpu) < TARGETS['cpu'])),
+                      '%-58s %10.2f s  < %g s: %s' % ('start-up: roslaunch to first odom->base_footprint',
+                                                      median(startup), TARGETS['startup'],
+                                                      verdict(median(startup) < TARGETS['startup']))]
+        if rss:
+            lines.append('%-58s %8.0f MiB' % ('peak RSS of the simulator node (max over runs)', max(rss)))
         for script, _ in (demo.SCRIPTS if scripts else []):
             (wall_1, end_1), (wall_0, end_0) = scripts[1.0][script], scripts[0.0][script]
             ratio = wall_1 / wall_0

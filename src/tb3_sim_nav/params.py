@@ -82,7 +82,7 @@ PARAMETERS = [
     Parameter('paused', False, bool, None, '', 'start with physics paused (/gazebo/unpause_physics resumes)'),
     Parameter('physics_rate', 100.0, float, _positive, 'Hz', 'physics steps per simulated second; /clock is published every step (Gazebo publishes it at 100 Hz)'),
     Parameter('max_clock_lead', 0.01, float, _non_negative, 's', 'faster than real time, how far /clock may run ahead of what a python subscriber of its own has received'),
-    Parameter('startup_hold', 0.5, float, _non_negative, 's (wall)', 'sim time holds this long when a node subscribes to /clock, so it can connect first'),
+    Parameter('startup_hold', 0.3, float, _non_negative, 's (wall)', 'sim time holds this long when a node subscribes to /clock, so it can connect first'),
     Parameter('odom_rate', 30.0, float, _positive, 'Hz', 'rate of odom, tf and base_pose_ground_truth (sim time)'),
     Parameter('joint_states_rate', 30.0, float, _positive, 'Hz', 'rate of joint_states (sim time)'),
     Parameter('max_linear_speed', 0.22, float, _positive, 'm/s', 'commands beyond this are clamped'),

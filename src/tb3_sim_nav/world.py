@@ -16,6 +16,7 @@ from .robot_model import LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT, urdf_for_pybullet
 GRAVITY = 9.81           # m/s^2
 GROUND_FRICTION = 1.0    # rubber tyre on a hard floor
 CASTER_LINK = 'caster_back_link'
+BODY_FRICTION = 0.3      # plastic plates against a wall
 STATIC_BODIES = 2        # Bullet's collision group of bodies with mass 0
 
 
@@ -49,6 +50,10 @@ class SimWorld(object):
         for wheel in self.wheels:
             pybullet.changeDynamics(self.robot, wheel, lateralFriction=ground_friction,
                                     rollingFriction=0.0, spinningFriction=0.0, **self._call)
+        # The plastic body slides along a wall rather than gripping it.
+        for link in [-1] + [index for name, index in links.items()
+                            if index not in self.wheels and name != CASTER_LINK]:
+            pybullet.changeDynamics(self.robot, link, lateralFriction=BODY_FRICTION, **self._call)
         # With no friction the ball caster carries weight but never steers the robot.
         pybullet.changeDynamics(self.robot, links[CASTER_LINK], lateralFriction=caster_friction,
                                 rollingFriction=0.0, spinningFriction=0.0, **self._call)

@@ -25,12 +25,21 @@ GROUND_TRUTH = '/base_pose_ground_truth'
 PR_SET_PDEATHSIG = 1
 
 Sample = namedtuple('Sample', 't x y yaw vx vy wz')
+#: A Sample with the height and tilt too (GroundTruth3D).
+Sample3D = namedtuple('Sample3D', Sample._fields + ('z', 'roll', 'pitch'))
 
 
 # --- maths -------------------------------------------------------------------
 def yaw_of(q):
     """Rotation about z of a geometry_msgs Quaternion."""
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def roll_pitch_of(q):
+    """Roll and pitch (rad) of a geometry_msgs Quaternion (ZYX Euler angles)."""
+    roll = math.atan2(2.0 * (q.w * q.x + q.y * q.z), 1.0 - 2.0 * (q.x * q.x + q.y * q.y))
+    pitch = math.asin(max(-1.0, min(1.0, 2.0 * (q.w * q.y - q.z * q.x))))
+    return roll, pitch
 
 
 def wrap(angle):
@@ -121,6 +130,16 @@ class GroundTruth(object):
         return [s for s in samples
                 if (start is None or s.t >= start) and (end is None or s.t <= end)]
 
+    def count(self):
+        """How many samples have arrived: a mark for `since` that survives a jump of sim time."""
+        with self._lock:
+            return len(self._samples)
+
+    def since(self, mark):
+        """The samples that arrived after `count()` returned `mark`, in arrival order."""
+        with self._lock:
+            return self._samples[mark:]
+
     def latest(self):
         with self._lock:
             return self._samples[-1] if self._samples else None
@@ -158,6 +177,28 @@ class GroundTruth(object):
             history = self.samples(end=now - window)
             return bool(history) and self.still_since(now - window)
         return self.latest() if wait_for(at_rest, timeout, poll=0.02) else None
+
+
+def after_jump_back(samples, before, jump=0.5):
+    """The samples (in arrival order) from the first one stamped more than `jump` s
+    before `before`, the sim time when time was reset; [] if there is none."""
+    for index, sample in enumerate(samples):
+        if sample.t < before - jump:
+            return samples[index:]
+    return []
+
+
+class GroundTruth3D(GroundTruth):
+    """GroundTruth whose samples also carry z, roll and pitch (Sample3D)."""
+
+    def _on_message(self, message):
+        pose, twist = message.pose.pose, message.twist.twist
+        roll, pitch = roll_pitch_of(pose.orientation)
+        sample = Sample3D(message.header.stamp.to_sec(), pose.position.x, pose.position.y,
+                          yaw_of(pose.orientation), twist.linear.x, twist.linear.y, twist.angular.z,
+                          pose.position.z, roll, pitch)
+        with self._lock:
+            self._samples.append(sample)
 
 
 # --- child processes -------------------------------------------------------------
@@ -258,3 +299,28 @@ def report(name, **values):
     print(line, flush=True)
     rospy.loginfo(line)
     return line
+
+
+# --- commands ------------------------------------------------------------------
+class Repeater(object):
+    """Publishes `message` on `publisher` at `rate` Hz of wall time until stop(),
+    as `rostopic pub -r` would; `message` may be changed while it runs."""
+
+    def __init__(self, publisher, message, rate=20.0):
+        self.publisher, self.message, self.period = publisher, message, 1.0 / rate
+        self.count = 0
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name='repeater', daemon=True)
+        self._thread.start()
+
+    def _run(self):
+        next_time = time.monotonic()
+        while not self._stop.is_set() and not rospy.is_shutdown():
+            self.publisher.publish(self.message)
+            self.count += 1
+            next_time += self.period
+            self._stop.wait(max(0.0, next_time - time.monotonic()))
+
+    def stop(self):
+        self._stop.set()
+        self._thread.join(2.0)
