@@ -53,10 +53,11 @@ def cpu_seconds(pid):
     return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
-def peak_rss_mib(pid):
+def memory_mib(pid, field='VmHWM'):
+    """A memory figure of /proc/PID/status in MiB: VmHWM (peak RSS) or VmRSS (now)."""
     with open('/proc/%d/status' % pid) as status:
         for line in status:
-            if line.startswith('VmHWM:'):
+            if line.startswith(field + ':'):
                 return int(line.split()[1]) / 1024.0
     return float('nan')
 
@@ -115,7 +116,7 @@ def measure_rtf(log_dir, params, seconds):
         sim_start, wall_start = listener.clock, time.monotonic()
         time.sleep(seconds)
         rtf = (listener.clock - sim_start) / (time.monotonic() - wall_start)
-        return rtf, peak_rss_mib(sim_pid())
+        return rtf, memory_mib(sim_pid())
     finally:
         listener.close()
         sim.stop()
@@ -142,7 +143,7 @@ def measure_cpu_and_startup(log_dir, seconds):
             publisher.publish(command)
             time.sleep(0.1)
         cpu = 100.0 * (cpu_seconds(pid) - cpu_start) / (time.monotonic() - wall_start)
-        return cpu, peak_rss_mib(pid), startup
+        return cpu, memory_mib(pid), startup
     finally:
         publisher.unregister()
         listener.close()

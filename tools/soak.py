@@ -30,14 +30,6 @@ LIMIT_MARGIN = 1.05
 HOSTILE = [float('nan'), float('inf'), -float('inf'), 1e308, -1e308, -0.0, 5.0, -5.0, 40.0]
 
 
-def rss_mib(pid):
-    with open('/proc/%d/status' % pid) as status:
-        for line in status:
-            if line.startswith('VmRSS:'):
-                return int(line.split()[1]) / 1024.0
-    return float('nan')
-
-
 def random_twist(rng):
     from geometry_msgs.msg import Twist
     twist = Twist()
@@ -138,7 +130,7 @@ def main(argv=None):
         sim = bench.start_sim('soak', log_dir, 0.0)
         bench.wait_until(lambda: clock.clock is not None and clock.clock > 2.0, 60, '/clock')
         pid = bench.sim_pid()
-        warm = rss_mib(pid)
+        warm = bench.memory_mib(pid, 'VmRSS')
         commands = demo.Process('flood', [sys.executable, __file__, '--flood', '--burst', str(args.burst),
                                           '--seed', str(args.seed)], log_dir)
         received = []
@@ -152,12 +144,12 @@ def main(argv=None):
                     raise demo.DemoError('%s exited (code %s); see %s'
                                          % (process.name, process.popen.returncode, process.log))
             if clock.clock - sim_start >= next_report:
-                say('soak: sim %.0f s, VmRSS %.1f MiB' % (clock.clock - sim_start, rss_mib(pid)))
+                say('soak: sim %.0f s, VmRSS %.1f MiB' % (clock.clock - sim_start, bench.memory_mib(pid, 'VmRSS')))
                 next_report += max(60.0, args.sim_seconds / 10)
             time.sleep(0.1)
         counter.unregister()
         sent = len(received)
-        growth = rss_mib(pid) - warm
+        growth = bench.memory_mib(pid, 'VmRSS') - warm
         wall = time.monotonic() - wall_start
         # Whole simulated seconds, leaving out the first and last (partly seen).
         counts = [count for second, count in sorted(checker.tf_per_second.items())][2:-1]

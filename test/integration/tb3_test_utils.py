@@ -86,6 +86,19 @@ def all_finite(message):
 
 
 # --- waiting -----------------------------------------------------------------
+def wait_for_simulator(truth, cmd_vel):
+    """Ground truth flowing, `cmd_vel` connected to the simulator and the robot
+    at rest after spawning: the rest sample, or AssertionError saying which not."""
+    if not truth.wait_first(60.0):
+        raise AssertionError('no base_pose_ground_truth within 60 s')
+    if not wait_for(lambda: cmd_vel.get_num_connections() > 0, 30.0):
+        raise AssertionError('the simulator never subscribed to /cmd_vel')
+    rest = truth.wait_at_rest(timeout=30.0)
+    if rest is None:
+        raise AssertionError('the robot did not come to rest after spawning')
+    return rest
+
+
 def wait_for(predicate, timeout, poll=0.005):
     """Poll `predicate` until it is true or `timeout` wall seconds pass; its last value."""
     deadline = time.monotonic() + timeout

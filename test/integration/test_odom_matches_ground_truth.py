@@ -23,7 +23,7 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from tf2_msgs.msg import TFMessage
 
-from tb3_test_utils import (GroundTruth, init_test_node, report, wait_for, wall_budget,
+from tb3_test_utils import (wait_for_simulator, GroundTruth, init_test_node, report, wait_for, wall_budget,
                             wrap)
 
 POSITION_TOLERANCE = 0.001            # m
@@ -98,13 +98,7 @@ class OdomMatchesGroundTruth(unittest.TestCase):
     @classmethod
     def _drive_pattern(cls):
         truth = cls.truth
-        if not truth.wait_first(60.0):
-            raise AssertionError('no base_pose_ground_truth within 60 s')
-        if not wait_for(lambda: cls.cmd_vel.get_num_connections() > 0, 30.0):
-            raise AssertionError('the simulator never subscribed to /cmd_vel')
-        start = truth.wait_at_rest(timeout=30.0)
-        if start is None:
-            raise AssertionError('the robot did not come to rest after spawning')
+        start = wait_for_simulator(truth, cls.cmd_vel)
         # Turn left to about 90 deg: there is no spawn-yaw launch argument.
         cls.command(0.0, TURN_SPEED)
         cls.turn_start = truth.now()

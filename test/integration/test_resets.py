@@ -29,7 +29,7 @@ from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty
 
 from script_test_case import ScriptTestCase
-from tb3_test_utils import (Child, GroundTruth, Sample, after_jump_back, in_frame_of, init_test_node,
+from tb3_test_utils import (wait_for_simulator, Child, GroundTruth, Sample, after_jump_back, in_frame_of, init_test_node,
                             report, speed, unwrapped_turn, wait_for, wall_budget, wrap, yaw_of)
 
 SPAWN = Sample(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
@@ -144,12 +144,7 @@ class Resets(ScriptTestCase):
     @classmethod
     def _phase_reset_world(cls):
         truth = cls.truth_all
-        if not truth.wait_first(60.0):
-            raise AssertionError('no base_pose_ground_truth within 60 s')
-        if not wait_for(lambda: cls.cmd_vel.get_num_connections() > 0, 30.0):
-            raise AssertionError('the simulator never subscribed to /cmd_vel')
-        if truth.wait_at_rest(timeout=30.0) is None:
-            raise AssertionError('the robot did not come to rest after spawning')
+        wait_for_simulator(truth, cls.cmd_vel)
         cls._drive(0.2, 0.5)
         cls.world_driven = truth.latest()
         clock_mark = cls.clock.count()

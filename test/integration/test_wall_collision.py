@@ -22,7 +22,7 @@ import rospy
 import rostest
 from geometry_msgs.msg import Twist
 
-from tb3_test_utils import (GroundTruth3D, Repeater, finite_difference_speeds, init_test_node,
+from tb3_test_utils import (wait_for_simulator, GroundTruth3D, Repeater, finite_difference_speeds, init_test_node,
                             report, speed, wait_for, wall_budget, wrap)
 
 WALL_FACE_X = -2.5            # inner face of the west wall (m)
@@ -72,12 +72,7 @@ class WallCollision(unittest.TestCase):
     @classmethod
     def _run(cls):
         truth = cls.truth
-        if not truth.wait_first(60.0):
-            raise AssertionError('no base_pose_ground_truth within 60 s')
-        if not wait_for(lambda: cls.cmd_vel.get_num_connections() > 0, 30.0):
-            raise AssertionError('the simulator never subscribed to /cmd_vel')
-        if truth.wait_at_rest(timeout=30.0) is None:
-            raise AssertionError('the robot did not come to rest after spawning')
+        wait_for_simulator(truth, cls.cmd_vel)
         if not cls._turn_to(math.pi, wall_budget(15.0)):
             raise AssertionError('could not turn to face -x: yaw %.1f deg' % math.degrees(truth.latest().yaw))
         cls.facing = truth.wait_at_rest(timeout=wall_budget(3.0))
