@@ -25,3 +25,22 @@ def burger_urdf():
 @pytest.fixture
 def worlds_folder():
     return REPO / 'worlds'
+
+
+@pytest.fixture
+def world_factory(burger_urdf):
+    """make(time_step, settle, spawn_pose, obstacles): a SimWorld left to
+    settle for `settle` s of sim time; every one is closed after the test."""
+    from tb3_sim_nav.world import SimWorld
+    worlds = []
+
+    def make(time_step, settle, spawn_pose=(0.0, 0.0, 0.0, 0.0), obstacles=()):
+        world = SimWorld(str(burger_urdf), spawn_pose=spawn_pose, time_step=time_step,
+                         obstacles=obstacles)
+        worlds.append(world)
+        for _ in range(int(round(settle / time_step))):
+            world.step()
+        return world
+    yield make
+    for world in worlds:
+        world.close()

@@ -7,7 +7,6 @@ import pytest
 from tb3_sim_nav.diff_drive import wheel_speeds
 from tb3_sim_nav.robot_model import read_drive_geometry
 from tb3_sim_nav.sensors import Imu, Lidar
-from tb3_sim_nav.world import SimWorld
 from tb3_sim_nav.world_file import Obstacle
 
 STEP = 1.0 / 200
@@ -34,18 +33,9 @@ ROOM = [box(SCAN_X + FRONT + WALL / 2, 0.0, WALL, 6.0),
 
 
 @pytest.fixture
-def make_world(burger_urdf):
+def make_world(world_factory):
     """make_world(obstacles): a world settled for 0.5 s; closed after the test."""
-    worlds = []
-
-    def make(obstacles=()):
-        world = SimWorld(str(burger_urdf), time_step=STEP, obstacles=obstacles)
-        worlds.append(world)
-        run(world, 0.5)
-        return world
-    yield make
-    for world in worlds:
-        world.close()
+    return lambda obstacles=(): world_factory(STEP, 0.5, obstacles=obstacles)
 
 
 def run(world, seconds):

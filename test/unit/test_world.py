@@ -7,7 +7,6 @@ import pytest
 
 from tb3_sim_nav.diff_drive import quaternion_to_yaw, wheel_speeds
 from tb3_sim_nav.robot_model import read_drive_geometry
-from tb3_sim_nav.world import SimWorld
 
 STEP = 1.0 / 200
 SETTLE_STEPS = 400  # 2 s for the robot to drop onto the ground and come to rest
@@ -19,18 +18,9 @@ def geometry(burger_urdf):
 
 
 @pytest.fixture
-def make_world(burger_urdf):
+def make_world(world_factory):
     """make_world(x, y, yaw): a settled world at that spawn pose; closed after the test."""
-    worlds = []
-
-    def make(x=0.0, y=0.0, yaw=0.0):
-        world = SimWorld(str(burger_urdf), spawn_pose=(x, y, 0.0, yaw), time_step=STEP)
-        worlds.append(world)
-        run(world, SETTLE_STEPS * STEP)
-        return world
-    yield make
-    for world in worlds:
-        world.close()
+    return lambda x=0.0, y=0.0, yaw=0.0: world_factory(STEP, SETTLE_STEPS * STEP, (x, y, 0.0, yaw))
 
 
 def run(world, seconds):
