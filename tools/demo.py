@@ -221,7 +221,6 @@ def wait_for_sim(sim, recorder):
 
 def run_script(script, expected, args, log_dir):
     """One round of the tutorial: fresh simulator, the script, simulator stopped."""
-    import rospy
     launch_argv = ['roslaunch', '--wait'] + list(LAUNCH) + ['real_time_factor:=%g' % args.real_time_factor]
     if args.profile is not None:
         launch_argv.append('profile:=%s' % args.profile)

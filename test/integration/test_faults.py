@@ -18,7 +18,6 @@ firmware's 0.5 s command timeout stops the robot.
 import math
 import signal
 import threading
-import time
 import unittest
 
 import rosnode
