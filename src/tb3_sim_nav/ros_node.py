@@ -257,10 +257,10 @@ class SimulatorNode(object):
             self.publish_imu(stamp)
 
     def publish_odometry(self, stamp):
-        odom_pose = self.sim.odometry_pose()
+        truth = (self.sim.true_pose(), self.sim.true_twist())
+        odom_pose, odom_twist = self.sim.odometry(truth)
         for message, (position, orientation), (linear, angular) in (
-                (self._odom, odom_pose, self.sim.odometry_twist()),
-                (self._truth, self.sim.true_pose(), self.sim.true_twist())):
+                (self._odom, odom_pose, odom_twist), (self._truth,) + truth):
             message.header.stamp = stamp
             _set_xyz(message.pose.pose.position, position)
             _set_quaternion(message.pose.pose.orientation, orientation)

@@ -124,6 +124,13 @@ class Simulation(object):
         """Body-frame linear and angular velocity of base_footprint."""
         return self.world.base_twist()
 
+    def odometry(self, truth):
+        """odom's (pose, twist), given the true ones: the truth itself (Gazebo)
+        or the encoders' dead reckoning, without reading the world twice."""
+        if self.config['odom_source'] == 'world':
+            return truth
+        return self.odometry_pose(), self.odometry_twist()
+
     def odometry_twist(self):
         """Body-frame linear and angular velocity that odom reports."""
         if self.config['odom_source'] == 'world':

@@ -247,3 +247,11 @@ def test_caster_friction_makes_a_timed_turn_fall_short(make_sim):
     assert free == pytest.approx(90.0, abs=0.5)
     assert free - dragging > 0.2
     assert free - stuck > 5.0
+
+
+def test_odometry_given_the_truth_is_the_truth_in_the_gazebo_profile_and_encoders_otherwise(make_sim):
+    sim = make_sim()
+    truth = (sim.true_pose(), sim.true_twist())
+    assert sim.odometry(truth) is truth
+    realistic = make_sim(profile='realistic', seed=1)
+    assert realistic.odometry(truth) == (realistic.odometry_pose(), realistic.odometry_twist())
