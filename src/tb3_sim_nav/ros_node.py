@@ -8,6 +8,7 @@ import sys
 import threading
 import time
 import warnings
+import xmlrpc.client
 
 import rosgraph
 import rospkg
@@ -22,13 +23,14 @@ from tf2_msgs.msg import TFMessage
 from . import params
 from .diff_drive import Limits, sanitize_twist
 from .pacing import Pacer, Schedule
+from .quiescence import ProcessGone, ProcessWatch, waits_for_input
 from .robot_model import LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT, ModelError, read_drive_geometry
 from .throttle import Throttle
 from .world_file import WorldError, load_world
 
 WARN_PERIOD = 5.0    # s between repeats of the same warning
 IDLE_POLL = 0.01     # wall s between checks while paused or holding
-ECHO_TIMEOUT = 0.05  # wall s to wait for our own /clock before stepping on regardless
+LOCKSTEP_POLL = 0.0001  # wall s between looks at a node the step waits for
 # Diagonal covariances of odom, as Gazebo's diff-drive plugin fills them:
 # x, y and yaw are known well; z, roll and pitch are not estimated at all.
 ODOM_COVARIANCE = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
@@ -96,7 +98,6 @@ class SimulatorNode(object):
         self._command = (0.0, 0.0, 0)  # v, w, count of commands received
         self._applied_count = 0
         self._hold_until = 0.0
-        self._max_lead_ns = int(round(config['max_clock_lead'] * 1e9))
         self._make_schedules()
         self._make_messages()
         self.clock_pub = _publisher('clock', Clock, subscriber_listener=_OnSubscribe(self._hold_clock))
@@ -106,14 +107,10 @@ class SimulatorNode(object):
         self.tf_pub = _publisher('tf', TFMessage)
         self.scan_pub = _publisher('scan', LaserScan) if simulation.lidar else None
         self.imu_pub = _publisher('imu', Imu) if simulation.imu else None
-        rospy.Subscriber('cmd_vel', Twist, self._on_cmd_vel, queue_size=10, tcp_nodelay=True)
+        self.lockstep = None  # set below; the cmd_vel callback may run before
+        cmd_vel = rospy.Subscriber('cmd_vel', Twist, self._on_cmd_vel, queue_size=10, tcp_nodelay=True)
         self._own_clock = _stop_following_clock()
-        # Faster than real time, listen to our own /clock (see _wait_for_echo).
-        self._echo_ns = 0
-        self._echo = threading.Condition()
-        self._echoing = not 0.0 < config['real_time_factor'] <= 1.0
-        if self._echoing:
-            rospy.Subscriber('clock', Clock, self._on_clock_echo, queue_size=1, tcp_nodelay=True)
+        self.lockstep = Lockstep(cmd_vel, config['lockstep_timeout'], self._warnings) if config['lockstep'] else None
         for name, handler in (('pause_physics', self._on_pause), ('unpause_physics', self._on_unpause),
                               ('reset_world', self._on_reset_world),
                               ('reset_simulation', self._on_reset_simulation)):
@@ -167,33 +164,14 @@ class SimulatorNode(object):
             if self._warnings.allow(complaint.split()[0]):
                 rospy.logwarn('cmd_vel: %s (at most one such warning per %g s)', complaint, WARN_PERIOD)
         self._command = (v, w, self._command[2] + 1)  # one assignment; the step loop picks it up
+        if self.lockstep:
+            self.lockstep.receive_threads.add(threading.get_native_id())
 
     def _hold_clock(self):
         """A node has subscribed to /clock: it is starting up. Hold time still
         while it connects its other topics, so that its first commands are not
         lost to connection set-up, which takes wall time, not sim time."""
         self._hold_until = time.monotonic() + self.config['startup_hold']
-
-    def _on_clock_echo(self, message):
-        with self._echo:
-            self._echo_ns = message.clock.to_nsec()
-            self._echo.notify()
-
-    def _wait_for_echo(self, now_ns):
-        """Hold the next step until our own /clock subscriber has seen `now_ns - lead`.
-
-        Faster than real time, every other node lags behind /clock by its
-        delivery and processing time, and a command it sends arrives that much
-        sim time late. Waiting for a python subscriber of our own (as slow as
-        theirs) bounds that lag in sim time whatever the factor.
-        """
-        deadline = time.monotonic() + ECHO_TIMEOUT
-        with self._echo:
-            while self._echo_ns < now_ns - self._max_lead_ns and not rospy.is_shutdown():
-                remaining = deadline - time.monotonic()
-                if remaining <= 0.0:
-                    return
-                self._echo.wait(remaining)
 
     def _on_pause(self, _request):
         self.pacer.pause()
@@ -212,8 +190,6 @@ class SimulatorNode(object):
     def _on_reset_simulation(self, _request):
         with self._lock:
             self.sim.reset_simulation()
-            with self._echo:
-                self._echo_ns = 0
             self.pacer.restart()
         rospy.loginfo('reset_simulation: robot back at its spawn pose, time back to zero')
         return EmptyResponse()
@@ -228,8 +204,8 @@ class SimulatorNode(object):
             self.pacer.wait_until((self.sim.steps + 1) * self.sim.step_ns * 1e-9)
             with self._lock:
                 self.step()
-            if self._echoing:
-                self._wait_for_echo(self.sim.now_ns)
+            if self.lockstep:
+                self.lockstep.wait()
 
     def step(self):
         v, w, count = self._command
@@ -237,24 +213,38 @@ class SimulatorNode(object):
             self.sim.command(v, w)
             self._applied_count = count
         self.sim.step()
+        now_ns = self.sim.now_ns
         # One stamp object for the whole step: publishing is synchronous, so
         # every message is serialised before the next step changes it.
         stamp = self._clock.clock
-        stamp.secs, stamp.nsecs = divmod(self.sim.now_ns, 1000000000)
-        now_ns = self.sim.now_ns
+        stamp.secs, stamp.nsecs = divmod(now_ns, 1000000000)
+        # The step's data goes out before /clock says its time has come, so a
+        # node woken by the tick reads this step's tf and odom, not the step
+        # before's (lockstep sees that it has): the same at any factor.
+        if self.publish_data(now_ns, stamp) and self.lockstep:
+            self.lockstep.wait()
         self.clock_pub.publish(self._clock)
+
+    def publish_data(self, now_ns, stamp):
+        """Publishes what is due at `now_ns`; False if nothing was."""
         due = self._due
+        published = False
         if due['odom'].due(now_ns):
             if self._own_clock:  # the stamps of our log messages need be no finer
                 rospy.rostime._set_rostime(stamp)
             self.publish_odometry(stamp)
+            published = True
         if due['joint_states'].due(now_ns):
             self.publish_joint_states(stamp)
+            published = True
         # The sensors cost most of a step: nobody listening, nothing computed.
         if self.scan_pub and due['scan'].due(now_ns) and self.scan_pub.get_num_connections():
             self.publish_scan(stamp)
+            published = True
         if self.imu_pub and due['imu'].due(now_ns) and self.imu_pub.get_num_connections():
             self.publish_imu(stamp)
+            published = True
+        return published
 
     def publish_odometry(self, stamp):
         truth = (self.sim.true_pose(), self.sim.true_twist())
@@ -292,6 +282,103 @@ class SimulatorNode(object):
         _set_xyz(self._imu.angular_velocity, reading.angular_velocity)
         _set_xyz(self._imu.linear_acceleration, reading.linear_acceleration)
         self.imu_pub.publish(self._imu)
+
+
+class _TimeoutTransport(xmlrpc.client.Transport):
+    def make_connection(self, host):
+        connection = super(_TimeoutTransport, self).make_connection(host)
+        connection.timeout = 1.0  # s: a node that hangs must not hang the simulator
+        return connection
+
+
+def _local_pid(connection):
+    """PID of the node at the other end of a subscriber connection, if it runs
+    on this machine (asked over its XML-RPC API, as rosnode does), else None."""
+    try:
+        sock = connection.socket
+        if sock.getpeername()[0] != sock.getsockname()[0]:
+            return None
+        proxy = xmlrpc.client.ServerProxy(connection.endpoint_id, transport=_TimeoutTransport())
+        code, _message, pid = proxy.getPid(rospy.get_name())
+        return pid if code == 1 else None
+    except Exception:  # closed, unreachable, not a ROS node: nothing to wait for
+        return None
+
+
+class Lockstep(object):
+    """Holds each step until the local nodes that publish cmd_vel have reacted to it.
+
+    Otherwise a node's reaction to a tick costs it wall time in which the
+    simulator runs on: its commands land late in sim time, and a rospy.Rate
+    loop that falls two periods behind drops ticks, so a script's path would
+    depend on the factor and the machine's load (even at real time, a python
+    script's first ticks, slowed by its connections, can be dropped). A node that has not reacted
+    within `timeout` (it computes, or never sleeps) is not waited for until it
+    is seen waiting again: the simulator never stalls on it.
+    """
+
+    def __init__(self, cmd_vel, timeout, warnings):
+        self._cmd_vel = cmd_vel
+        self._timeout = timeout
+        self._warnings = warnings
+        self._publishers = ()
+        self._watches = {}   # publisher URI -> ProcessWatch of its process
+        self._names = {}     # publisher URI -> node name, for messages
+        self._behind = set()  # URIs not waited for until seen waiting
+        self.receive_threads = set()  # native ids of the threads that ran our cmd_vel callback
+
+    def _follow_publishers(self):
+        """Watch the processes of cmd_vel's publishers, anew whenever they change."""
+        connections = list(self._cmd_vel.impl.connections) if self._cmd_vel.impl else []
+        publishers = tuple(sorted(connection.endpoint_id for connection in connections))
+        if publishers == self._publishers:
+            return
+        self._publishers = publishers
+        for uri in set(self._watches) - set(publishers):
+            self._watches.pop(uri).close()
+            self._names.pop(uri, None)
+            self._behind.discard(uri)
+        self.receive_threads.clear()  # ended connections' threads; live ones come back
+        for connection in connections:
+            pid = None if connection.endpoint_id in self._watches else _local_pid(connection)
+            if pid is not None:
+                try:
+                    self._watches[connection.endpoint_id] = ProcessWatch(pid)
+                    self._names[connection.endpoint_id] = connection.callerid_pub
+                except ProcessGone:
+                    pass
+
+    def _reacted(self, uri):
+        try:
+            return self._watches[uri].waiting()
+        except ProcessGone:  # it ended: nothing more will come from it
+            return True
+
+    def wait(self):
+        self._follow_publishers()
+        for uri in list(self._behind):
+            if self._reacted(uri):
+                self._behind.discard(uri)
+        pending = [uri for uri in self._watches if uri not in self._behind]
+        deadline = time.monotonic() + self._timeout
+        while True:
+            pending = [uri for uri in pending if not self._reacted(uri)]
+            if not pending:
+                break
+            if time.monotonic() > deadline:
+                self._behind.update(pending)
+                if self._warnings.allow('lockstep'):
+                    rospy.logwarn('lockstep: %s did not wait for /clock within %g s (wall); stepping on '
+                                  'without it until it does (at most one such warning per %g s)',
+                                  ', '.join(self._names.get(uri, uri) for uri in pending),
+                                  self._timeout, WARN_PERIOD)
+                return
+            time.sleep(LOCKSTEP_POLL)
+        # The commands they sent are read: let our callback have handled them.
+        while not all(waits_for_input(tid) for tid in tuple(self.receive_threads)):
+            if time.monotonic() > deadline:
+                return
+            time.sleep(LOCKSTEP_POLL)
 
 
 class MasterWatch(threading.Thread):
@@ -378,8 +465,9 @@ def main():
     rospy.init_node('tb3_sim')
     config, simulation = _start_up()
     if config['real_time_factor'] == 0.0:
-        # As fast as possible, but only on CPU that no other node wants: a
-        # script starved of CPU would react late in sim time.
+        # As fast as possible, but only on CPU that no other node wants, so
+        # that rviz and the shell stay responsive (lockstep waits for the
+        # nodes that drive the robot whatever their priority).
         os.nice(10)
     try:
         node = SimulatorNode(config, simulation)

@@ -1,0 +1,108 @@
+"""Has a process finished reacting? Read off Linux's /proc, without ROS.
+
+Faster than real time, the simulator holds each step until the nodes that
+drive the robot have done what the last tick asked of them (see ros_node's
+lockstep). A process has done so when every thread of it sleeps and none ran
+between two looks: Linux marks a thread runnable the moment data, a lock or a
+signal wakes it, so a process whose threads all sleep twice over, with the
+same run counters, waits for something new from outside.
+"""
+import os
+import platform
+
+#: Thread states of /proc/.../stat that will not act before something new
+#: arrives: asleep, stopped (Ctrl+Z), traced, dead. 'D' (disk) and 'R' will.
+WAITING_STATES = frozenset(b'STtZXI')
+
+#: Syscalls, by number per machine, in which a thread waits for data on a
+#: socket: poll/ppoll (python's sockets with a timeout), recvfrom and read.
+_IO_WAIT_SYSCALLS = {'x86_64': frozenset((7, 271, 45, 0)),
+                     'aarch64': frozenset((73, 207, 63))}
+IO_WAIT_SYSCALLS = _IO_WAIT_SYSCALLS.get(platform.machine())
+
+
+class ProcessGone(Exception):
+    """The process ended (or was never there)."""
+
+
+def _read(fd, size=512):
+    return os.pread(fd, size, 0)
+
+
+class ProcessWatch(object):
+    """Watches the threads of one process; keeps their /proc files open, as
+    reading an open file costs a fifth of opening it anew."""
+
+    def __init__(self, pid, proc='/proc'):
+        self.pid = pid
+        self._task_dir = os.path.join(proc, str(pid), 'task')
+        self._files = {}  # tid -> (stat fd, schedstat fd or None)
+        if not os.path.isdir(self._task_dir):
+            raise ProcessGone(pid)
+
+    def close(self):
+        for stat, schedstat in self._files.values():
+            os.close(stat)
+            if schedstat is not None:
+                os.close(schedstat)
+        self._files.clear()
+
+    def _open(self, tid):
+        stat = os.open(os.path.join(self._task_dir, tid, 'stat'), os.O_RDONLY)
+        try:
+            schedstat = os.open(os.path.join(self._task_dir, tid, 'schedstat'), os.O_RDONLY)
+        except OSError:  # a kernel without scheduler statistics: states only
+            schedstat = None
+        return stat, schedstat
+
+    def _threads(self):
+        try:
+            tids = os.listdir(self._task_dir)
+        except OSError:
+            raise ProcessGone(self.pid)
+        for tid in set(self._files) - set(tids):
+            stat, schedstat = self._files.pop(tid)
+            os.close(stat)
+            if schedstat is not None:
+                os.close(schedstat)
+        for tid in tids:
+            if tid not in self._files:
+                try:
+                    self._files[tid] = self._open(tid)
+                except OSError:  # the thread ended between listing and opening
+                    pass
+        return self._files.items()
+
+    def snapshot(self):
+        """Each thread's run counters now, or None when a thread runs or is runnable."""
+        counters = []
+        for tid, (stat, schedstat) in self._threads():
+            try:
+                line = _read(stat)
+                # The state follows the command name, which may hold spaces and ')'.
+                state = line[line.rindex(b')') + 2]
+                if state not in WAITING_STATES:
+                    return None
+                counters.append((tid, _read(schedstat) if schedstat is not None else b''))
+            except (OSError, ValueError, IndexError):  # the thread just ended
+                continue
+        return counters
+
+    def waiting(self):
+        """True when every thread sleeps and none ran between two looks."""
+        first = self.snapshot()
+        return first is not None and self.snapshot() == first
+
+
+def waits_for_input(tid, proc='/proc/self'):
+    """True when thread `tid` (of this process) is blocked waiting for socket
+    data, that is, it has handled all it read. On an unknown machine the
+    syscall numbers are unknown: say True and rely on timing."""
+    if IO_WAIT_SYSCALLS is None:
+        return True
+    try:
+        with open(os.path.join(proc, 'task', str(tid), 'syscall'), 'rb') as syscall:
+            fields = syscall.read().split()
+    except OSError:  # the thread ended: its connection closed
+        return True
+    return bool(fields) and fields[0].isdigit() and int(fields[0]) in IO_WAIT_SYSCALLS
