@@ -42,6 +42,7 @@ MASTER_TIMEOUT = 30.0     # wall s for roscore to answer
 SIM_READY_TIMEOUT = 60.0  # wall s for the simulator to give odom -> base_footprint
 STOP_TIMEOUT = 30.0       # wall s for a process group to end after SIGINT (roslaunch escalates after 15 s)
 HEARTBEAT = 15.0          # wall s between progress lines while a script runs
+SETTLE = 1.5              # wall s a script started while paused gets to connect its topics
 LAUNCH = ('tb3_sim_bringup', 'tb3_empty_world.launch')
 
 
@@ -219,11 +220,60 @@ def wait_for_sim(sim, recorder):
         listener.unregister()
 
 
+def start_script_paused(sim, script, log_dir):
+    """With the simulator paused at time 0: the script started, given time to
+    connect (its publisher of /cmd_vel registered, then SETTLE wall seconds),
+    and physics unpaused. The script then starts at the same sim time in every
+    run, whatever the factor and however long python takes to start."""
+    import rosgraph
+    import rospy
+    from std_srvs.srv import Empty
+    deadline = time.monotonic() + SIM_READY_TIMEOUT
+    master = rosgraph.Master(rospy.get_name())
+
+    def wait_until(predicate, what, process=None):
+        while not predicate():
+            if not sim.running():
+                raise DemoError('the simulator exited (code %s); %s ends with:\n%s'
+                                % (sim.popen.returncode, sim.log, tail(sim.log)))
+            if process is not None and not process.running():
+                raise DemoError('%s exited (code %s) before the simulator was unpaused; %s ends with:\n%s'
+                                % (script, process.popen.returncode, process.log, tail(process.log)))
+            if time.monotonic() > deadline:
+                raise DemoError('no %s after %.0f s' % (what, SIM_READY_TIMEOUT))
+            time.sleep(0.1)
+
+    def has_service(name):
+        return any(service == name for service, _ in master.getSystemState()[2])
+
+    def publishes_cmd_vel():
+        return any(topic == '/cmd_vel' and set(nodes) - {'/tb3_sim'}
+                   for topic, nodes in master.getSystemState()[0])
+
+    wait_until(lambda: has_service('/gazebo/unpause_physics'), 'simulator (its unpause service)')
+    process = Process(script[:-3], ['rosrun', 'tb3_sim_nav', script], log_dir)
+    try:
+        wait_until(publishes_cmd_vel, 'publisher of /cmd_vel from %s' % script, process)
+        settle = time.monotonic() + SETTLE
+        wait_until(lambda: time.monotonic() >= settle, 'end of the settling time', process)
+        rospy.ServiceProxy('/gazebo/unpause_physics', Empty)()
+    except BaseException:
+        process.stop(timeout=10.0)
+        raise
+    return process
+
+
 def run_script(script, expected, args, log_dir):
-    """One round of the tutorial: fresh simulator, the script, simulator stopped."""
+    """One round of the tutorial: fresh simulator, the script, simulator stopped.
+
+    With args.paused_start the simulator starts paused and the script is
+    started before time does (start_script_paused), for runs to compare."""
+    paused_start = getattr(args, 'paused_start', False)
     launch_argv = ['roslaunch', '--wait'] + list(LAUNCH) + ['real_time_factor:=%g' % args.real_time_factor]
     if args.profile is not None:
         launch_argv.append('profile:=%s' % args.profile)
+    if paused_start:
+        launch_argv.append('paused:=true')
     sim = script_process = recorder = start_index = None
     truth = odom = []
     wall_time = sim_time = exit_code = error = None
@@ -231,12 +281,18 @@ def run_script(script, expected, args, log_dir):
         say('%s: starting the simulator: %s' % (script, ' '.join(launch_argv)))
         sim = Process(script[:-3] + '.sim', launch_argv, log_dir)
         recorder = Recorder()
-        wait_for_sim(sim, recorder)
-        say('%s: simulator ready (odom -> base_footprint), sim time %.2f s; rosrun tb3_sim_nav %s'
-            % (script, sim_now(), script))
-        wall_start, sim_start = time.monotonic(), sim_now()
-        start_index = (len(recorder.truth) - 1, len(recorder.odom) - 1)
-        script_process = Process(script[:-3], ['rosrun', 'tb3_sim_nav', script], log_dir)
+        wall_start = time.monotonic()
+        if paused_start:
+            say('%s: simulator paused at time 0; rosrun tb3_sim_nav %s, then unpause' % (script, script))
+            script_process = start_script_paused(sim, script, log_dir)
+            sim_start, start_index = 0.0, (0, 0)
+        else:
+            wait_for_sim(sim, recorder)
+            say('%s: simulator ready (odom -> base_footprint), sim time %.2f s; rosrun tb3_sim_nav %s'
+                % (script, sim_now(), script))
+            wall_start, sim_start = time.monotonic(), sim_now()
+            start_index = (len(recorder.truth) - 1, len(recorder.odom) - 1)
+            script_process = Process(script[:-3], ['rosrun', 'tb3_sim_nav', script], log_dir)
         sim_limit = TIMEOUT_FACTOR * expected
         wall_limit = STARTUP_SLACK + sim_limit / (args.real_time_factor or 1.0)
         next_beat = wall_start + HEARTBEAT
