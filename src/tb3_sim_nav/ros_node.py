@@ -367,9 +367,11 @@ class Lockstep(object):
                 break
             if time.monotonic() > deadline:
                 self._behind.update(pending)
+                # Information, not a fault: at real time nothing waits for
+                # a busy node either (Gazebo never does).
                 if self._warnings.allow('lockstep'):
-                    rospy.logwarn('lockstep: %s did not wait for /clock within %g s (wall); stepping on '
-                                  'without it until it does (at most one such warning per %g s)',
+                    rospy.loginfo('lockstep: %s did not wait for /clock within %g s (wall); stepping on '
+                                  'without it until it does (at most one such message per %g s)',
                                   ', '.join(self._names.get(uri, uri) for uri in pending),
                                   self._timeout, WARN_PERIOD)
                 return
