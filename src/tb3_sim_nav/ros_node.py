@@ -30,7 +30,8 @@ from .world_file import WorldError, load_world
 
 WARN_PERIOD = 5.0    # s between repeats of the same warning
 IDLE_POLL = 0.01     # wall s between checks while paused or holding
-LOCKSTEP_POLL = 0.0001  # wall s between looks at a node the step waits for
+LOCKSTEP_POLL = 0.0001  # wall s between looks at a node the step waits for, at least ...
+LOCKSTEP_POLL_SHARE = 0.05  # ... and this share of a step's wall time when paced
 # Diagonal covariances of odom, as Gazebo's diff-drive plugin fills them:
 # x, y and yaw are known well; z, roll and pitch are not estimated at all.
 ODOM_COVARIANCE = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
@@ -110,7 +111,10 @@ class SimulatorNode(object):
         self.lockstep = None  # set below; the cmd_vel callback may run before
         cmd_vel = rospy.Subscriber('cmd_vel', Twist, self._on_cmd_vel, queue_size=10, tcp_nodelay=True)
         self._own_clock = _stop_following_clock()
-        self.lockstep = Lockstep(cmd_vel, config['lockstep_timeout'], self._warnings) if config['lockstep'] else None
+        # Paced, a step has wall time to spare: look less often, for less CPU.
+        factor = config['real_time_factor']
+        poll = max(LOCKSTEP_POLL, LOCKSTEP_POLL_SHARE / config['physics_rate'] / factor) if factor else LOCKSTEP_POLL
+        self.lockstep = Lockstep(cmd_vel, config['lockstep_timeout'], poll, self._warnings) if config['lockstep'] else None
         for name, handler in (('pause_physics', self._on_pause), ('unpause_physics', self._on_unpause),
                               ('reset_world', self._on_reset_world),
                               ('reset_simulation', self._on_reset_simulation)):
@@ -317,9 +321,10 @@ class Lockstep(object):
     is seen waiting again: the simulator never stalls on it.
     """
 
-    def __init__(self, cmd_vel, timeout, warnings):
+    def __init__(self, cmd_vel, timeout, poll, warnings):
         self._cmd_vel = cmd_vel
         self._timeout = timeout
+        self._poll = poll
         self._warnings = warnings
         self._publishers = ()
         self._watches = {}   # publisher URI -> ProcessWatch of its process
@@ -375,12 +380,12 @@ class Lockstep(object):
                                   ', '.join(self._names.get(uri, uri) for uri in pending),
                                   self._timeout, WARN_PERIOD)
                 return
-            time.sleep(LOCKSTEP_POLL)
+            time.sleep(self._poll)
         # The commands they sent are read: let our callback have handled them.
         while not all(waits_for_input(tid) for tid in tuple(self.receive_threads)):
             if time.monotonic() > deadline:
                 return
-            time.sleep(LOCKSTEP_POLL)
+            time.sleep(self._poll)
 
 
 class MasterWatch(threading.Thread):
