@@ -41,11 +41,13 @@ class ProcessWatch(object):
             raise ProcessGone(pid)
 
     def close(self):
-        for stat, schedstat in self._files.values():
-            os.close(stat)
-            if schedstat is not None:
-                os.close(schedstat)
-        self._files.clear()
+        for tid in list(self._files):
+            self._forget(tid)
+
+    def _forget(self, tid):
+        for fd in self._files.pop(tid):
+            if fd is not None:
+                os.close(fd)
 
     def _open(self, tid):
         stat = os.open(os.path.join(self._task_dir, tid, 'stat'), os.O_RDONLY)
@@ -61,10 +63,7 @@ class ProcessWatch(object):
         except OSError:
             raise ProcessGone(self.pid)
         for tid in set(self._files) - set(tids):
-            stat, schedstat = self._files.pop(tid)
-            os.close(stat)
-            if schedstat is not None:
-                os.close(schedstat)
+            self._forget(tid)
         for tid in tids:
             if tid not in self._files:
                 try:
