@@ -316,9 +316,9 @@ class Lockstep(object):
     simulator runs on: its commands land late in sim time, and a rospy.Rate
     loop that falls two periods behind drops ticks, so a script's path would
     depend on the factor and the machine's load (even at real time, a python
-    script's first ticks, slowed by its connections, can be dropped). A node that has not reacted
-    within `timeout` (it computes, or never sleeps) is not waited for until it
-    is seen waiting again: the simulator never stalls on it.
+    script's first ticks, slowed by its connections, can be dropped). A node
+    that has not reacted within `timeout` (it computes, or never sleeps) is not
+    waited for until it is seen waiting again: the simulator never stalls on it.
     """
 
     def __init__(self, cmd_vel, timeout, poll, warnings):
@@ -326,48 +326,51 @@ class Lockstep(object):
         self._timeout = timeout
         self._poll = poll
         self._warnings = warnings
-        self._publishers = ()
-        self._watches = {}   # publisher URI -> ProcessWatch of its process
-        self._names = {}     # publisher URI -> node name, for messages
-        self._behind = set()  # URIs not waited for until seen waiting
+        self._connections = None  # the list of cmd_vel connections last followed
+        self._connecting = False  # some of them still shaking hands
+        self._watches = {}   # publisher node name -> ProcessWatch of its process
+        self._behind = set()  # node names not waited for until seen waiting
         self.receive_threads = set()  # native ids of the threads that ran our cmd_vel callback
 
     def _follow_publishers(self):
         """Watch the processes of cmd_vel's publishers, anew whenever they change."""
-        connections = list(self._cmd_vel.impl.connections) if self._cmd_vel.impl else []
-        publishers = tuple(sorted(connection.endpoint_id for connection in connections))
-        if publishers == self._publishers:
+        impl = self._cmd_vel.impl
+        # rospy replaces the list whenever a connection comes or goes, and
+        # lists a connection before a thread of its own has connected it:
+        # look again each step until every listed one has its handshake done.
+        if impl is None or (impl.connections is self._connections and not self._connecting):
             return
-        self._publishers = publishers
-        for uri in set(self._watches) - set(publishers):
-            self._watches.pop(uri).close()
-            self._names.pop(uri, None)
-            self._behind.discard(uri)
+        connections = self._connections = impl.connections
+        connected = [connection for connection in connections if connection.header is not None]
+        self._connecting = len(connected) < len(connections)
+        names = set(connection.callerid_pub for connection in connected)
+        for name in set(self._watches) - names:
+            self._watches.pop(name).close()
+            self._behind.discard(name)
         self.receive_threads.clear()  # ended connections' threads; live ones come back
-        for connection in connections:
-            pid = None if connection.endpoint_id in self._watches else _local_pid(connection)
+        for connection in connected:
+            pid = None if connection.callerid_pub in self._watches else _local_pid(connection)
             if pid is not None:
                 try:
-                    self._watches[connection.endpoint_id] = ProcessWatch(pid)
-                    self._names[connection.endpoint_id] = connection.callerid_pub
+                    self._watches[connection.callerid_pub] = ProcessWatch(pid)
                 except ProcessGone:
                     pass
 
-    def _reacted(self, uri):
+    def _reacted(self, name):
         try:
-            return self._watches[uri].waiting()
+            return self._watches[name].waiting()
         except ProcessGone:  # it ended: nothing more will come from it
             return True
 
     def wait(self):
         self._follow_publishers()
-        for uri in list(self._behind):
-            if self._reacted(uri):
-                self._behind.discard(uri)
-        pending = [uri for uri in self._watches if uri not in self._behind]
+        for name in list(self._behind):
+            if self._reacted(name):
+                self._behind.discard(name)
+        pending = [name for name in self._watches if name not in self._behind]
         deadline = time.monotonic() + self._timeout
         while True:
-            pending = [uri for uri in pending if not self._reacted(uri)]
+            pending = [name for name in pending if not self._reacted(name)]
             if not pending:
                 break
             if time.monotonic() > deadline:
@@ -377,8 +380,7 @@ class Lockstep(object):
                 if self._warnings.allow('lockstep'):
                     rospy.loginfo('lockstep: %s did not wait for /clock within %g s (wall); stepping on '
                                   'without it until it does (at most one such message per %g s)',
-                                  ', '.join(self._names.get(uri, uri) for uri in pending),
-                                  self._timeout, WARN_PERIOD)
+                                  ', '.join(pending), self._timeout, WARN_PERIOD)
                 return
             time.sleep(self._poll)
         # The commands they sent are read: let our callback have handled them.
