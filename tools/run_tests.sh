@@ -1,18 +1,37 @@
 # make test (run with bash, inside `source setup.bash`): the unit tests
 # (pytest, no master), catkin_lint, then each integration test with rostest,
 # which starts its own master on a free port. Exit status: 0 only if all pass.
+# Each part's output is shown as it runs and kept; the lines that say why a
+# part failed are repeated at the end, where a CI log's tail shows them.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 export ROS_HOSTNAME=localhost
 unset ROS_IP
+logs=$(mktemp -d)
+trap 'rm -rf "$logs"' EXIT
 failures=()
+
+# run NAME COMMAND...: run it, its output to the terminal and to $logs/NAME.
+run() {
+  local name=$1
+  shift
+  "$@" 2>&1 | tee "$logs/$name" || failures+=("$name")
+}
+
+# The lines of a failed part's output that say what failed: pytest's short
+# summary, rostest's failure headers, the exception line of each traceback,
+# the soak's missed rows.
+why() {
+  grep -E '^(FAILED|ERROR) |\]\[(FAILURE|ERROR)\]-|(Error|Exception)(: |$)|  MISSED$|FAILED: ' "$1" \
+    | awk '!seen[$0]++' | head -40
+}
 
 if [ "${1:-}" != --integration-only ]; then
   echo "== unit tests (pytest, no master)"
-  python3 -m pytest -q -p no:cacheprovider test/unit || failures+=(unit)
+  run unit python3 -m pytest -q -p no:cacheprovider test/unit
   echo "== catkin_lint"
   lint=$(catkin_lint --strict -W2 "$(rospack find tb3_sim_nav)" 2>&1)
-  echo "$lint"
+  echo "$lint" | tee "$logs/catkin_lint"
   echo "$lint" | grep -qE ': (error|warning|notice):' && failures+=(catkin_lint)
 fi
 
@@ -20,22 +39,26 @@ fi
 # restarted, bad start-up configurations, and the tutorial's scripts run at
 # factors 1, 5 and 0 against one another (a fresh simulator for each run).
 echo "== system tests (pytest, masters of their own)"
-python3 -m pytest -q -p no:cacheprovider test/system || failures+=(system)
+run system python3 -m pytest -q -p no:cacheprovider test/system
 
 for test_file in test/*.test; do
   name=$(basename "$test_file")
   echo "== rostest tb3_sim_nav $name"
   # Not --text: with it rostest exits 0 even when a test fails. SIGINT first on
   # a time-out: rostest then stops every node it started.
-  timeout --signal=INT --kill-after=20 600 rostest tb3_sim_nav "$name" || failures+=("$name")
+  run "$name" timeout --signal=INT --kill-after=20 600 rostest tb3_sim_nav "$name"
 done
 
 if [ "${1:-}" != --integration-only ]; then
   echo "== short soak: 120 s of sim time under random and hostile commands"
-  timeout --signal=INT --kill-after=20 600 python3 tools/soak.py --sim-seconds 120 --check || failures+=(soak)
+  run soak timeout --signal=INT --kill-after=20 600 python3 tools/soak.py --sim-seconds 120 --check
 fi
 
 if [ ${#failures[@]} -gt 0 ]; then
+  for name in "${failures[@]}"; do
+    echo "== why $name failed"
+    why "$logs/$name"
+  done
   echo "FAILED: ${failures[*]}"
   exit 1
 fi
