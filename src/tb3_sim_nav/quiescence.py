@@ -4,8 +4,8 @@ Faster than real time, the simulator holds each step until the nodes that
 drive the robot have done what the last tick asked of them (see ros_node's
 lockstep). A process has done so when every thread of it sleeps and none ran
 between two looks: Linux marks a thread runnable the moment data, a lock or a
-signal wakes it, so a process whose threads all sleep twice over, with the
-same run counters, waits for something new from outside.
+signal wakes it, so a process whose threads all sleep, none having run
+since a look a moment before, waits for something new from outside.
 """
 import os
 import platform
@@ -36,9 +36,11 @@ class ProcessWatch(object):
     def __init__(self, pid, proc='/proc'):
         self.pid = pid
         self._task_dir = os.path.join(proc, str(pid), 'task')
-        self._files = {}  # tid -> (stat fd, schedstat fd or None)
         if not os.path.isdir(self._task_dir):
             raise ProcessGone(pid)
+        self._files = {}  # tid -> (stat fd, schedstat fd or None)
+        self._busy = None  # the thread last seen running or runnable
+        self._counted = os.path.exists(os.path.join(self._task_dir, str(pid), 'schedstat'))
 
     def close(self):
         for tid in list(self._files):
@@ -70,27 +72,47 @@ class ProcessWatch(object):
                     self._files[tid] = self._open(tid)
                 except OSError:  # the thread ended between listing and opening
                     pass
-        return self._files.items()
+        return list(self._files.items())
 
-    def snapshot(self):
-        """Each thread's run counters now, or None when a thread runs or is runnable."""
+    def _sleeps(self, stat):
+        line = _read(stat)
+        # The state follows the command name, which may hold spaces and ')'.
+        return line[line.rindex(b')') + 2] in WAITING_STATES
+
+    def _look(self, threads, states):
+        """Each thread's run counters; None if `states` and a thread runs or is runnable."""
         counters = []
-        for tid, (stat, schedstat) in self._threads():
+        for tid, (stat, schedstat) in threads:
             try:
-                line = _read(stat)
-                # The state follows the command name, which may hold spaces and ')'.
-                state = line[line.rindex(b')') + 2]
-                if state not in WAITING_STATES:
+                if states and not self._sleeps(stat):
+                    self._busy = tid
                     return None
                 counters.append((tid, _read(schedstat) if schedstat is not None else b''))
             except (OSError, ValueError, IndexError):  # the thread just ended
                 continue
         return counters
 
+    def snapshot(self):
+        """Each thread's run counters now, or None when a thread runs or is runnable."""
+        return self._look(self._threads(), states=True)
+
     def waiting(self):
-        """True when every thread sleeps and none ran between two looks."""
-        first = self.snapshot()
-        return first is not None and self.snapshot() == first
+        """True when every thread sleeps and none ran between two looks.
+
+        The first look needs only the run counters: a thread asleep at the
+        second that did not run in between was asleep all along (it can stop
+        running or being runnable only by running). The thread last seen busy
+        is asked first, as the likeliest to be busy still.
+        """
+        threads = self._threads()  # one listing: a thread started in between means one ran
+        busy = self._files.get(self._busy)
+        try:
+            if busy is not None and not self._sleeps(busy[0]):
+                return False
+        except (OSError, ValueError, IndexError):
+            pass
+        first = self._look(threads, states=not self._counted)
+        return first is not None and self._look(threads, states=True) == first
 
 
 def waits_for_input(tid, proc='/proc/self'):

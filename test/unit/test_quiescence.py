@@ -70,14 +70,32 @@ def test_a_process_whose_thread_computes_is_not_waiting(child):
 
 def test_a_thread_that_ran_between_the_two_looks_is_not_waiting(tmp_path):
     """Asleep at both looks, but its run counters moved: it ran in between."""
-    write_thread(tmp_path / '42' / 'task', 42, b'42 (python3) S 1 42', schedstat=b'1000 0 3\n')
+    task = tmp_path / '42' / 'task'
+    write_thread(task, 42, b'42 (python3) S 1 42', schedstat=b'1000 0 3\n')
     watch = ProcessWatch(42, proc=str(tmp_path))
-    first = watch.snapshot()
-    write_thread(tmp_path / '42' / 'task', 42, b'42 (python3) S 1 42', schedstat=b'1900 0 4\n')
-    assert watch.snapshot() != first
-    looks = iter([first, watch.snapshot()])
-    watch.snapshot = lambda: next(looks)
+    assert watch.waiting()
+    first_look = watch._look
+
+    def look_then_run(threads, states):
+        counters = first_look(threads, states)
+        write_thread(task, 42, b'42 (python3) S 1 42', schedstat=b'1900 0 4\n')
+        return counters
+    watch._look = look_then_run
     assert not watch.waiting()
+    watch.close()
+
+
+def test_the_thread_last_seen_busy_is_asked_first(tmp_path):
+    task = tmp_path / '5' / 'task'
+    for tid in (5, 6, 7):
+        write_thread(task, tid, b'%d (n) S 1 5 5' % tid)
+    write_thread(task, 7, b'7 (n) R 1 5 5')
+    watch = ProcessWatch(5, proc=str(tmp_path))
+    assert not watch.waiting()
+    looks = []
+    watch._look = lambda threads, states: looks.append(states)
+    assert not watch.waiting()
+    assert looks == [], 'still busy: no need to look at every thread'
     watch.close()
 
 
