@@ -101,7 +101,9 @@ class SimulatorNode(object):
         self._hold_until = 0.0
         self._make_schedules()
         self._make_messages()
-        self.clock_pub = _publisher('clock', Clock, subscriber_listener=_OnSubscribe(self._hold_clock))
+        # Latched: a node that starts gets the time at once, even while paused,
+        # not after a data message stamped later (hztest then measures nothing).
+        self.clock_pub = _publisher('clock', Clock, subscriber_listener=_OnSubscribe(self._hold_clock), latch=True)
         self.odom_pub = _publisher('odom', Odometry)
         self.truth_pub = _publisher('base_pose_ground_truth', Odometry)
         self.joints_pub = _publisher('joint_states', JointState)
@@ -127,7 +129,6 @@ class SimulatorNode(object):
     def _make_messages(self):
         """Messages reused every publication: only stamps and values change."""
         frame, child = self.config['odom_frame'], self.config['base_frame']
-        self._clock = Clock(clock=rospy.Time(0, 0))
         self._odom = Odometry()
         self._odom.header.frame_id = frame
         self._odom.child_frame_id = child
@@ -200,16 +201,22 @@ class SimulatorNode(object):
 
     # --- the step loop ------------------------------------------------------
     def run(self):
+        step_s = self.sim.step_ns * 1e-9
         while not rospy.is_shutdown():
             if self.pacer.paused or time.monotonic() < self._hold_until:
                 self.pacer.restart()
                 time.sleep(IDLE_POLL)
                 continue
-            self.pacer.wait_until((self.sim.steps + 1) * self.sim.step_ns * 1e-9)
-            with self._lock:
-                self.step()
+            tick = (self.sim.steps + 1) * step_s
+            # Paced, the physics runs half a step before its tick is due: the
+            # nodes have had half a step to react to the last tick, and get
+            # another half to read this step's data, so that lockstep's looks
+            # mostly find them waiting at once (looking costs CPU).
+            self.pacer.wait_until(tick - 0.5 * step_s)
             if self.lockstep:
                 self.lockstep.wait()
+            with self._lock:
+                self.step()
 
     def step(self):
         v, w, count = self._command
@@ -218,16 +225,17 @@ class SimulatorNode(object):
             self._applied_count = count
         self.sim.step()
         now_ns = self.sim.now_ns
-        # One stamp object for the whole step: publishing is synchronous, so
-        # every message is serialised before the next step changes it.
-        stamp = self._clock.clock
-        stamp.secs, stamp.nsecs = divmod(now_ns, 1000000000)
+        # One stamp for the whole step, new each step: rospy sends the latched
+        # /clock to a new subscriber from another thread, so it must not change.
+        stamp = rospy.Time(*divmod(now_ns, 1000000000))
+        published = self.publish_data(now_ns, stamp)
+        self.pacer.wait_until(now_ns * 1e-9)
         # The step's data goes out before /clock says its time has come, so a
         # node woken by the tick reads this step's tf and odom, not the step
         # before's (lockstep sees that it has): the same at any factor.
-        if self.publish_data(now_ns, stamp) and self.lockstep:
+        if published and self.lockstep:
             self.lockstep.wait()
-        self.clock_pub.publish(self._clock)
+        self.clock_pub.publish(Clock(clock=stamp))
 
     def publish_data(self, now_ns, stamp):
         """Publishes what is due at `now_ns`; False if nothing was."""
