@@ -115,15 +115,37 @@ class ProcessWatch(object):
         return first is not None and self._look(threads, states=True) == first
 
 
-def waits_for_input(tid, proc='/proc/self'):
-    """True when thread `tid` (of this process) is blocked waiting for socket
-    data, that is, it has handled all it read. On an unknown machine the
-    syscall numbers are unknown: say True and rely on timing."""
-    if IO_WAIT_SYSCALLS is None:
-        return True
-    try:
-        with open(os.path.join(proc, 'task', str(tid), 'syscall'), 'rb') as syscall:
-            fields = syscall.read().split()
-    except OSError:  # the thread ended: its connection closed
-        return True
-    return bool(fields) and fields[0].isdigit() and int(fields[0]) in IO_WAIT_SYSCALLS
+class InputWaits(object):
+    """Threads of this process that receive from sockets (rospy has one per
+    connection), with their /proc syscall files kept open: all_waiting() says
+    when each is blocked waiting for socket data, having handled all it read."""
+
+    def __init__(self, proc='/proc/self'):
+        self._task_dir = os.path.join(proc, 'task')
+        self._files = {}  # tid -> fd of its syscall file
+
+    def add(self, tid):
+        """Follow thread `tid` (a callback calls this from its own thread)."""
+        if tid not in self._files and IO_WAIT_SYSCALLS is not None:
+            try:
+                self._files[tid] = os.open(os.path.join(self._task_dir, str(tid), 'syscall'), os.O_RDONLY)
+            except OSError:  # it ended already
+                pass
+
+    def clear(self):
+        files, self._files = self._files, {}
+        for fd in files.values():
+            os.close(fd)
+
+    def all_waiting(self):
+        """On an unknown machine the syscall numbers are unknown: True, and
+        lockstep relies on the looks at the other nodes alone."""
+        return all(self._waits(fd) for fd in tuple(self._files.values()))
+
+    @staticmethod
+    def _waits(fd):
+        try:
+            fields = _read(fd, 128).split()
+        except OSError:  # the thread ended: its connection closed
+            return True
+        return bool(fields) and fields[0].isdigit() and int(fields[0]) in IO_WAIT_SYSCALLS

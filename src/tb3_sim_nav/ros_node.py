@@ -23,7 +23,7 @@ from tf2_msgs.msg import TFMessage
 from . import params
 from .diff_drive import Limits, sanitize_twist
 from .pacing import Pacer, Schedule
-from .quiescence import ProcessGone, ProcessWatch, waits_for_input
+from .quiescence import InputWaits, ProcessGone, ProcessWatch
 from .robot_model import LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT, ModelError, read_drive_geometry
 from .throttle import Throttle
 from .world_file import WorldError, load_world
@@ -338,7 +338,7 @@ class Lockstep(object):
         self._connecting = False  # some of them still shaking hands
         self._watches = {}   # publisher node name -> ProcessWatch of its process
         self._behind = set()  # node names not waited for until seen waiting
-        self.receive_threads = set()  # native ids of the threads that ran our cmd_vel callback
+        self.receive_threads = InputWaits()  # the threads that ran our cmd_vel callback
 
     def _follow_publishers(self):
         """Watch the processes of cmd_vel's publishers, anew whenever they change."""
@@ -392,7 +392,7 @@ class Lockstep(object):
                 return
             time.sleep(self._poll)
         # The commands they sent are read: let our callback have handled them.
-        while not all(waits_for_input(tid) for tid in tuple(self.receive_threads)):
+        while not self.receive_threads.all_waiting():
             if time.monotonic() > deadline:
                 return
             time.sleep(self._poll)

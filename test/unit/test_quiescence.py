@@ -9,7 +9,7 @@ import time
 import pytest
 
 from tb3_sim_nav import quiescence
-from tb3_sim_nav.quiescence import ProcessGone, ProcessWatch, waits_for_input
+from tb3_sim_nav.quiescence import InputWaits, ProcessGone, ProcessWatch
 
 SETTLE = 5.0  # wall s a real process or thread gets to reach the state a test waits for
 
@@ -160,11 +160,11 @@ def test_a_thread_waits_for_input_only_while_blocked_reading_its_socket():
     ours, theirs = socket.socketpair()
     ours.settimeout(60.0)
     lock = threading.Lock()
-    tid = []
+    receivers = InputWaits()
     handled = []
 
     def receive():
-        tid.append(threading.get_native_id())
+        receivers.add(threading.get_native_id())
         while True:
             data = ours.recv(64)
             if not data:
@@ -174,16 +174,18 @@ def test_a_thread_waits_for_input_only_while_blocked_reading_its_socket():
     thread = threading.Thread(target=receive, daemon=True)
     thread.start()
     try:
-        assert eventually(lambda: tid and waits_for_input(tid[0]))
+        assert eventually(receivers.all_waiting)
         with lock:
             theirs.sendall(b'twist')
-            assert eventually(lambda: not waits_for_input(tid[0]))
+            assert eventually(lambda: not receivers.all_waiting())
             time.sleep(0.1)
-            assert not waits_for_input(tid[0]), 'blocked on a lock is not waiting for input'
-        assert eventually(lambda: handled and waits_for_input(tid[0]))
+            assert not receivers.all_waiting(), 'blocked on a lock is not waiting for input'
+        assert eventually(lambda: handled and receivers.all_waiting())
     finally:
         theirs.close()
         thread.join(SETTLE)
         ours.close()
     # join() returns a moment before the kernel has ended the thread.
-    assert eventually(lambda: waits_for_input(tid[0])), 'an ended thread has nothing left to handle'
+    assert eventually(receivers.all_waiting), 'an ended thread has nothing left to handle'
+    receivers.clear()
+    assert receivers.all_waiting(), 'no thread followed: nothing to wait for'
