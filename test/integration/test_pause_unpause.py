@@ -3,10 +3,14 @@
 
 With the robot driving: pause stops /clock (over a wall-time wait) and the
 robot (no ground-truth pose changes, and after unpausing it resumes where it
-was, not 2 s further on); unpause makes /clock advance again, at the real-time
-factor (no rush to catch up), and the robot drives on with its last command.
+was, not 2 s further on); a node started while paused has the paused time at
+once (/clock is latched), not zero; unpause makes /clock advance again, at the
+real-time factor (no rush to catch up), and the robot drives on with its last
+command.
 """
 import math
+import subprocess
+import sys
 import threading
 import time
 import unittest
@@ -22,6 +26,13 @@ from tb3_test_utils import (GroundTruth, init_test_node, real_time_factor, repor
 
 PAUSED_WALL_SECONDS = 2.0
 DRIVE = (0.1, 0.3)
+# A node of its own (rospy inits once per process): its sim time, once it has one.
+LATE_NODE = ('import time, rospy\n'
+             'rospy.init_node("started_while_paused", anonymous=True)\n'
+             'deadline = time.monotonic() + 10.0\n'
+             'while rospy.get_time() == 0.0 and time.monotonic() < deadline:\n'
+             '    time.sleep(0.01)\n'
+             'print(repr(rospy.get_time()))\n')
 
 
 class ClockWatch(object):
@@ -73,7 +84,11 @@ class PauseUnpause(unittest.TestCase):
         time.sleep(0.2)
         paused_clock, paused_count = clock.latest(), clock.count()
         paused_pose = truth.latest()
-        time.sleep(PAUSED_WALL_SECONDS)  # the point: wall time passes, sim time must not
+        paused_wall = time.monotonic()
+        late = subprocess.run([sys.executable, '-c', LATE_NODE], stdout=subprocess.PIPE,
+                              universal_newlines=True, timeout=60)
+        # The point: wall time passes, sim time must not.
+        time.sleep(max(0.0, paused_wall + PAUSED_WALL_SECONDS - time.monotonic()))
         clock_during, count_during = clock.latest(), clock.count()
         pose_during = truth.latest()
         report('paused', clock_before=paused_clock, clock_after=clock_during,
@@ -82,6 +97,11 @@ class PauseUnpause(unittest.TestCase):
         self.assertEqual(clock_during, paused_clock,
                          '/clock advanced %.3f s while paused' % (clock_during - paused_clock))
         self.assertEqual(count_during, paused_count, '/clock kept publishing while paused')
+        report('started_while_paused', exit_code=late.returncode, its_time=late.stdout.strip())
+        self.assertEqual(late.returncode, 0, 'the node started while paused failed')
+        self.assertAlmostEqual(float(late.stdout), paused_clock, places=6,
+                               msg='a node started while paused has time %s, not the paused %.3f'
+                               % (late.stdout.strip(), paused_clock))
         self.assertEqual((pose_during.x, pose_during.y, pose_during.yaw),
                          (paused_pose.x, paused_pose.y, paused_pose.yaw),
                          'the ground-truth pose changed while paused')
