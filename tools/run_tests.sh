@@ -18,12 +18,13 @@ run() {
   "$@" 2>&1 | tee "$logs/$name" || failures+=("$name")
 }
 
-# The lines of a failed part's output that say what failed: pytest's short
-# summary, rostest's failure headers, the exception line of each traceback,
-# the soak's missed rows.
+# The lines of a failed part's output that say what failed: rostest's failure
+# headers with the message after each, pytest's short summary, the exception
+# line of each traceback, the soak's missed rows.
 why() {
-  grep -E '^(FAILED|ERROR) |\]\[(FAILURE|ERROR)\]-|(Error|Exception)(: |$)|  MISSED$|FAILED: ' "$1" \
-    | awk '!seen[$0]++' | head -40
+  { grep -E -A1 '\]\[(FAILURE|ERROR)\]' "$1"
+    grep -E '^(FAILED|ERROR) |(Error|Exception)(: |$)|  MISSED$|FAILED: ' "$1"
+  } | grep -v '^--$' | awk '!seen[$0]++' | head -40
 }
 
 if [ "${1:-}" != --integration-only ]; then
