@@ -3,6 +3,7 @@
 The only module of the package that imports rospy. One physics step gives
 one timestamp to everything it publishes.
 """
+import math
 import os
 import sys
 import threading
@@ -32,6 +33,7 @@ WARN_PERIOD = 5.0    # s between repeats of the same warning
 IDLE_POLL = 0.01     # wall s between checks while paused or holding
 LOCKSTEP_POLL = 0.0001  # wall s between looks at a node the step waits for, at least ...
 LOCKSTEP_POLL_SHARE = 0.05  # ... and this share of a step's wall time when paced
+PID_RETRY = 1.0      # wall s between asks of a local node that did not tell its PID
 # Diagonal covariances of odom, as Gazebo's diff-drive plugin fills them:
 # x, y and yaw are known well; z, roll and pitch are not estimated at all.
 ODOM_COVARIANCE = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
@@ -304,17 +306,23 @@ class _TimeoutTransport(xmlrpc.client.Transport):
 
 
 def _local_pid(connection):
-    """PID of the node at the other end of a subscriber connection, if it runs
-    on this machine (asked over its XML-RPC API, as rosnode does), else None."""
+    """PID of the node at the other end of a subscriber connection, asked over
+    its XML-RPC API (as rosnode does); None if it runs on another machine.
+    Raises LookupError when a node on this machine does not tell."""
     try:
         sock = connection.socket
         if sock.getpeername()[0] != sock.getsockname()[0]:
             return None
-        proxy = xmlrpc.client.ServerProxy(connection.endpoint_id, transport=_TimeoutTransport())
-        code, _message, pid = proxy.getPid(rospy.get_name())
-        return pid if code == 1 else None
-    except Exception:  # closed, unreachable, not a ROS node: nothing to wait for
+    except (AttributeError, OSError):  # closed meanwhile: nothing to wait for
         return None
+    try:
+        proxy = xmlrpc.client.ServerProxy(connection.endpoint_id, transport=_TimeoutTransport())
+        code, message, pid = proxy.getPid(rospy.get_name())
+    except Exception as error:  # refused, timed out, not a ROS node
+        raise LookupError(str(error) or type(error).__name__)
+    if code != 1:
+        raise LookupError(message)
+    return pid
 
 
 class Lockstep(object):
@@ -336,6 +344,7 @@ class Lockstep(object):
         self._warnings = warnings
         self._connections = None  # the list of cmd_vel connections last followed
         self._connecting = False  # some of them still shaking hands
+        self._ask_again_at = math.inf  # when to ask a local node that did not tell its PID
         self._watches = {}   # publisher node name -> ProcessWatch of its process
         self._behind = set()  # node names not waited for until seen waiting
         self.receive_threads = InputWaits()  # the threads that ran our cmd_vel callback
@@ -346,7 +355,8 @@ class Lockstep(object):
         # rospy replaces the list whenever a connection comes or goes, and
         # lists a connection before a thread of its own has connected it:
         # look again each step until every listed one has its handshake done.
-        if impl is None or (impl.connections is self._connections and not self._connecting):
+        if impl is None or (impl.connections is self._connections and not self._connecting
+                            and time.monotonic() < self._ask_again_at):
             return
         connections = self._connections = impl.connections
         connected = [connection for connection in connections if connection.header is not None]
@@ -356,13 +366,24 @@ class Lockstep(object):
             self._watches.pop(name).close()
             self._behind.discard(name)
         self.receive_threads.clear()  # ended connections' threads; live ones come back
+        unknown = []
         for connection in connected:
-            pid = None if connection.callerid_pub in self._watches else _local_pid(connection)
-            if pid is not None:
-                try:
-                    self._watches[connection.callerid_pub] = ProcessWatch(pid)
-                except ProcessGone:
-                    pass
+            name = connection.callerid_pub
+            if name in self._watches:
+                continue
+            try:
+                pid = _local_pid(connection)
+                if pid is not None:
+                    self._watches[name] = ProcessWatch(pid)
+            except ProcessGone:
+                pass
+            except LookupError as error:
+                unknown.append('%s (%s)' % (name, error))
+        # Not waited for until it tells: ask again a second later.
+        self._ask_again_at = time.monotonic() + PID_RETRY if unknown else math.inf
+        if unknown and self._warnings.allow('lockstep pid'):
+            rospy.loginfo('lockstep: no PID from %s: not waiting for it; asking again every %g s (wall)',
+                          ', '.join(unknown), PID_RETRY)
 
     def _reacted(self, name):
         try:
