@@ -16,6 +16,7 @@ time 0 in every run, only the factor differs.
 """
 import argparse
 import math
+import os
 import sys
 
 import pytest
@@ -58,10 +59,15 @@ def test_script_ends_within_1cm_1deg_at_factors_5_and_0_of_factor_1(script, expe
     # 40-80 sim s), which its limit of 4x the expected sim time did not allow for.
     # This test is about where the scripts end: a limit that cannot cut them short.
     monkeypatch.setattr(demo, 'TIMEOUT_FACTOR', 10.0)
-    ends, walls = {}, {}
+    ends, walls, behind = {}, {}, {}
     for factor in FACTORS:
         options = argparse.Namespace(real_time_factor=factor, profile=None, paused_start=True)
-        result, error = demo.run_script(script, expected, options, demo_node)
+        log_dir = os.path.join(demo_node, 'factor_%g' % factor)
+        os.makedirs(log_dir, exist_ok=True)
+        result, error = demo.run_script(script, expected, options, log_dir)
+        # Steps lockstep did not wait for a node (logged once per 5 s at most).
+        with open(os.path.join(log_dir, script[:-3] + '.sim.log')) as sim_log:
+            behind[factor] = sum(1 for line in sim_log if 'lockstep:' in line)
         assert error is None, '%s at real_time_factor %g: %s' % (script, factor, error)
         summary = demo_report.summarize(result)
         assert summary is not None, '%s at real_time_factor %g: no ground truth recorded' % (script, factor)
@@ -73,10 +79,13 @@ def test_script_ends_within_1cm_1deg_at_factors_5_and_0_of_factor_1(script, expe
         apart = math.hypot(x - x1, y - y1)
         turned = abs(math.degrees(demo_report.normalize(yaw - yaw1)))
         print('MEASURED speed_agreement %s factor %g: apart %.4f m, %.3f deg; ends factor 1 (%+.4f, %+.4f, '
-              '%+.2f deg), factor %g (%+.4f, %+.4f, %+.2f deg); wall/sim s factor 1 %.1f/%.1f, factor %g %.1f/%.1f'
+              '%+.2f deg), factor %g (%+.4f, %+.4f, %+.2f deg); wall/sim s factor 1 %.1f/%.1f, factor %g %.1f/%.1f; '
+              'lockstep left it behind factor 1 %d, factor %g %d times'
               % (script, factor, apart, turned, x1, y1, math.degrees(yaw1), factor, x, y, math.degrees(yaw),
-                 walls[1.0][0], walls[1.0][1], factor, walls[factor][0], walls[factor][1]), flush=True)
+                 walls[1.0][0], walls[1.0][1], factor, walls[factor][0], walls[factor][1],
+                 behind[1.0], factor, behind[factor]), flush=True)
         if apart > POSITION_TOLERANCE or turned > HEADING_TOLERANCE:
-            failures.append('%s ends %.4f m and %.3f deg from its factor 1 end at factor %g'
-                            % (script, apart, turned, factor))
+            failures.append('%s ends %.4f m and %.3f deg from its factor 1 end at factor %g (lockstep left it '
+                            'behind %d times at factor 1, %d at factor %g)'
+                            % (script, apart, turned, factor, behind[1.0], behind[factor], factor))
     assert not failures, '; '.join(failures)
