@@ -5,7 +5,7 @@ prints medians over several runs, with the machine and the date, and marks
 each figure against its target. It starts one master on a free loopback port
 and stops everything it starts by process group (the demo's machinery).
 
-    python3 tools/bench.py [--runs N] [--quick]
+    python3 tools/bench.py [--runs N] [--parts rtf,cpu,scripts]
 """
 import argparse
 import datetime
@@ -20,9 +20,13 @@ import xmlrpc.client
 import demo
 import demo_report
 from demo import Process, say
+from tcpros_reader import TcprosReader
 
 LAUNCH = ['roslaunch', '--wait', 'tb3_sim_bringup', 'tb3_empty_world.launch']
 TOPICS = ['clock', 'odom', 'tf', 'joint_states', 'base_pose_ground_truth', 'scan', 'imu']
+# Each topic is read by a TcprosReader (nearly free), or in this row by one
+# rospy node, which handles each message in python.
+ROSPY_READER = 'every topic on, read by a rospy node'
 SENSOR_SETS = [('every topic on', {}), ('without scan', {'scan': False}),
                ('without imu', {'imu': False}), ('without scan and imu', {'scan': False, 'imu': False})]
 CPU_SCRIPT = 'odom_out_and_back.py'  # the tutorial script that reads tf
@@ -40,11 +44,18 @@ def machine():
                                             platform.python_version())
 
 
+def sim_uri():
+    """XML-RPC URI of the /tb3_sim node, or None while it is not registered."""
+    import rosgraph
+    try:
+        return rosgraph.Master('/tb3_bench').lookupNode('/tb3_sim')
+    except rosgraph.MasterException:
+        return None
+
+
 def sim_pid():
     """PID of the /tb3_sim node, from its own XML-RPC API."""
-    import rosgraph
-    uri = rosgraph.Master('/tb3_bench').lookupNode('/tb3_sim')
-    return xmlrpc.client.ServerProxy(uri).getPid('/tb3_bench')[2]
+    return xmlrpc.client.ServerProxy(sim_uri()).getPid('/tb3_bench')[2]
 
 
 def cpu_seconds(pid):
@@ -110,19 +121,29 @@ def wait_until(predicate, timeout, what):
         time.sleep(0.01)
 
 
-def measure_rtf(log_dir, params, seconds):
-    """Sim seconds per wall second at factor 0, and the node's peak RSS."""
-    listener = Listener()
+def measure_rtf(log_dir, params, seconds, rospy_reader=False):
+    """Sim seconds per wall second at factor 0, and the node's peak RSS. Every
+    topic is read by a TcprosReader, or with `rospy_reader` by a rospy node."""
+    listener = Listener() if rospy_reader else None
     sim = start_sim('rtf', log_dir, 0.0, params)
+    readers = []
     try:
-        wait_until(lambda: listener.clock is not None and listener.clock > 1.0, 60, '/clock')
+        if listener is None:
+            readers = [TcprosReader(sim_uri, '/' + topic) for topic in TOPICS if params.get(topic, True)]
+            clock = next(reader for reader in readers if reader.topic == '/clock')
+        else:
+            clock = listener
+        wait_until(lambda: clock.clock is not None and clock.clock > 1.0, 60, '/clock')
         time.sleep(1.0)
-        sim_start, wall_start = listener.clock, time.monotonic()
+        sim_start, wall_start = clock.clock, time.monotonic()
         time.sleep(seconds)
-        rtf = (listener.clock - sim_start) / (time.monotonic() - wall_start)
+        rtf = (clock.clock - sim_start) / (time.monotonic() - wall_start)
         return rtf, memory_mib(sim_pid())
     finally:
-        listener.close()
+        for reader in readers:
+            reader.close()
+        if listener is not None:
+            listener.close()
         sim.stop()
 
 
@@ -225,6 +246,13 @@ def main(argv=None):
                 say('max real-time factor, %s, run %d: %.1f' % (label, run + 1, value))
                 rtf[label].append(value)
                 rss.append(peak)
+        if 'rtf' in parts:
+            rtf[ROSPY_READER] = []
+            for run in range(args.runs):
+                value, peak = measure_rtf(log_dir, {}, args.seconds, rospy_reader=True)
+                say('max real-time factor, %s, run %d: %.1f' % (ROSPY_READER, run + 1, value))
+                rtf[ROSPY_READER].append(value)
+                rss.append(peak)
         cpu, cpu_script, startup = [], [], []
         for run in range(args.runs if 'cpu' in parts else 0):
             used, peak, started = measure_cpu_and_startup(log_dir, args.cpu_seconds)
@@ -247,7 +275,7 @@ def main(argv=None):
             full = median(rtf['every topic on'])
             lines.append('%-58s %12.1f  >= %g: %s' % ('max real-time factor, headless empty world, every topic on',
                                                      full, TARGETS['rtf'], verdict(full >= TARGETS['rtf'])))
-            for label, _ in SENSOR_SETS[1:]:
+            for label in [label for label, _ in SENSOR_SETS[1:]] + [ROSPY_READER]:
                 lines.append('%-58s %12.1f' % ('max real-time factor, ' + label, median(rtf[label])))
         if cpu:
             lines += ['%-58s %11.1f%%  < %g %%: %s' % ('CPU of the simulator at factor 1, driving, all topics read',
