@@ -209,16 +209,11 @@ class SimulatorNode(object):
                 self.pacer.restart()
                 time.sleep(IDLE_POLL)
                 continue
-            tick = (self.sim.steps + 1) * step_s
-            # Paced, the physics runs half a step before its tick is due: the
-            # nodes have had half a step to react to the last tick, and get
-            # another half to read this step's data, so that lockstep's looks
-            # mostly find them waiting at once (looking costs CPU).
-            self.pacer.wait_until(tick - 0.5 * step_s)
-            if self.lockstep:
-                self.lockstep.wait()
+            self.pacer.wait_until((self.sim.steps + 1) * step_s)
             with self._lock:
                 self.step()
+            if self.lockstep:
+                self.lockstep.wait()
 
     def step(self):
         v, w, count = self._command
@@ -231,7 +226,6 @@ class SimulatorNode(object):
         # /clock to a new subscriber from another thread, so it must not change.
         stamp = rospy.Time(*divmod(now_ns, 1000000000))
         published = self.publish_data(now_ns, stamp)
-        self.pacer.wait_until(now_ns * 1e-9)
         # The step's data goes out before /clock says its time has come, so a
         # node woken by the tick reads this step's tf and odom, not the step
         # before's (lockstep sees that it has): the same at any factor.
