@@ -82,7 +82,7 @@ PARAMETERS = [
     Parameter('paused', False, bool, None, '', 'start with physics paused (/gazebo/unpause_physics resumes)'),
     Parameter('physics_rate', 100.0, float, _positive, 'Hz', 'physics steps per simulated second; /clock is published every step (Gazebo publishes it at 100 Hz)'),
     Parameter('lockstep', True, bool, None, '', 'hold each step until the local nodes publishing cmd_vel have reacted to it, so their commands land at the same sim time at any factor'),
-    Parameter('lockstep_timeout', 0.05, float, _positive, 's (wall)', 'longest a step waits for such a node; one that takes longer is not waited for until it waits again'),
+    Parameter('lockstep_timeout', 0.5, float, _positive, 's (wall)', 'longest a step waits for such a node; one that takes longer is not waited for until it waits again'),
     Parameter('startup_hold', 0.3, float, _non_negative, 's (wall)', 'sim time holds this long when a node subscribes to /clock, so it can connect first'),
     Parameter('odom_rate', 30.0, float, _positive, 'Hz', 'rate of odom, tf and base_pose_ground_truth (sim time)'),
     Parameter('joint_states_rate', 30.0, float, _positive, 'Hz', 'rate of joint_states (sim time)'),
