@@ -387,10 +387,10 @@ class Lockstep(object):
 
     def wait(self):
         self._follow_publishers()
-        for name in list(self._behind):
-            if self._reacted(name):
-                self._behind.discard(name)
-        pending = [name for name in self._watches if name not in self._behind]
+        # A node left behind and now seen waiting has reacted: no second look.
+        recovered = set(name for name in self._behind if self._reacted(name))
+        self._behind -= recovered
+        pending = [name for name in self._watches if name not in self._behind and name not in recovered]
         deadline = time.monotonic() + self._timeout
         while True:
             pending = [name for name in pending if not self._reacted(name)]
