@@ -38,15 +38,11 @@ class Lidar(object):
         """Ranges (m) of one full turn, as a numpy array."""
         origin, orientation = self.world.link_pose(self.link)
         rotation = np.reshape(pybullet.getMatrixFromQuaternion(orientation), (3, 3))
-        starts = np.tile(origin, (len(self._beams), 1))
-        ends = starts + self._beams.dot(rotation.T) * self.range_max
-        # (body id, hit fraction) per beam; body id -1: no hit.
-        hits = np.array([hit[0:3:2] for hit in self.world.cast_rays(starts, ends)])
-        hit_something = hits[:, 0] >= 0
-        ranges = hits[:, 1] * self.range_max
+        ends = origin + self._beams.dot(rotation.T) * self.range_max
+        ranges = self.world.cast_rays(origin, ends) * self.range_max
+        hit_something = np.isfinite(ranges)
         if self.noise_stddev > 0.0:
             ranges = ranges + self.rng.normal(0.0, self.noise_stddev, len(ranges))
-        ranges[~hit_something] = math.inf
         ranges[hit_something & (ranges < self.range_min)] = -math.inf
         ranges[hit_something & (ranges > self.range_max)] = math.inf
         return ranges

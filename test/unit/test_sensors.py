@@ -204,3 +204,43 @@ def test_imu_without_noise_parameters_is_noiseless(make_world):
     got = readings(world, Imu(world), 0.5)
     rates = np.array([reading.angular_velocity for reading in got])
     assert np.std(rates, axis=0).max() < 1e-5
+
+
+# --- ray casting ---------------------------------------------------------------------
+
+def every_ray_cast(world, origin, ends):
+    """What cast_rays must give: pybullet's own answer for every ray, uncut."""
+    import pybullet
+    from tb3_sim_nav.world import STATIC_BODIES
+    hits = pybullet.rayTestBatch(np.broadcast_to(origin, ends.shape), ends, numThreads=1,
+                                 collisionFilterMask=STATIC_BODIES, physicsClientId=world.client)
+    return np.array([hit[2] if hit[0] >= 0 else math.inf for hit in hits])
+
+
+@pytest.mark.parametrize('seed', range(5))
+def test_rays_left_uncast_are_exactly_those_that_hit_nothing(world_factory, worlds_folder, seed):
+    from tb3_sim_nav.world_file import load_world
+    # Where tb3_world.launch spawns it, beside a pillar of the world's own.
+    world = world_factory(STEP, 0.0, (-2.0, -0.5, 0.0, 0.0),
+                          load_world('turtlebot3_world', str(worlds_folder)) + [pillar(-1.7, -0.5)])
+    rng = np.random.default_rng(seed)
+    hits = 0
+    for _ in range(20):
+        # Origins in and far around the world, some inside obstacles, some
+        # below ground; rays of 0.1 to 4 m, some downwards, some along an axis.
+        origin = np.append(rng.uniform(-7.0, 7.0, 2), rng.uniform(-0.05, 0.4))
+        directions = rng.normal(size=(100, 3)) * (1.0, 1.0, rng.uniform(0.0, 0.3))
+        directions[:10, 1:] = 0.0
+        ends = origin + directions / np.linalg.norm(directions, axis=1)[:, None] * rng.uniform(0.1, 4.0, (100, 1))
+        expected = every_ray_cast(world, origin, ends)
+        hits += np.isfinite(expected).sum()
+        np.testing.assert_array_equal(world.cast_rays(origin, ends), expected)
+    assert hits > 100
+
+
+def test_rays_in_an_empty_world_above_ground_are_not_cast(make_world, monkeypatch):
+    import pybullet
+    world = make_world()
+    monkeypatch.setattr(pybullet, 'rayTestBatch', lambda *args, **kwargs: pytest.fail('cast'))
+    ends = np.array([[3.0, 0.0, 0.2], [0.0, -3.0, 0.01]])
+    assert np.all(world.cast_rays((0.0, 0.0, 0.2), ends) == math.inf)
