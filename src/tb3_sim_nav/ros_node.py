@@ -210,10 +210,12 @@ class SimulatorNode(object):
                 time.sleep(IDLE_POLL)
                 continue
             self.pacer.wait_until((self.sim.steps + 1) * step_s)
-            with self._lock:
-                self.step()
+            # Each step waits for the nodes' reaction to the last tick. Paced,
+            # they have had the sleep to react: one look mostly finds them done.
             if self.lockstep:
                 self.lockstep.wait()
+            with self._lock:
+                self.step()
 
     def step(self):
         v, w, count = self._command
