@@ -199,6 +199,23 @@ def measure_cpu_of_script(log_dir, script):
         sim.stop()
 
 
+def measure_floor(log_dir, seconds, physics):
+    """CPU of tools/clock_floor.py, which only sleeps to each tick and
+    publishes /clock (with `physics`, steps pybullet too): for scale."""
+    listener = Listener(topics=('clock',))
+    argv = [sys.executable, os.path.join(demo.ROOT, 'tools', 'clock_floor.py')] + (['--physics'] if physics else [])
+    floor = Process('floor' + ('_physics' if physics else ''), argv, log_dir)
+    try:
+        wait_until(lambda: listener.clock is not None, 60, '/clock from clock_floor.py')
+        time.sleep(1.0)
+        cpu_start, wall_start = cpu_seconds(floor.popen.pid), time.monotonic()
+        time.sleep(seconds)
+        return 100.0 * (cpu_seconds(floor.popen.pid) - cpu_start) / (time.monotonic() - wall_start)
+    finally:
+        listener.close()
+        floor.stop()
+
+
 def run_scripts(log_dir, factor):
     """Each tutorial script on a fresh simulator at `factor`: wall time and end pose."""
     options = argparse.Namespace(real_time_factor=factor, profile=None)
@@ -224,8 +241,9 @@ def main(argv=None):
     parser.add_argument('--runs', type=int, default=3, help='runs per figure (median reported)')
     parser.add_argument('--seconds', type=float, default=10.0, help='wall s per real-time-factor run')
     parser.add_argument('--cpu-seconds', type=float, default=30.0, help='wall s of the CPU measurement')
-    parser.add_argument('--parts', default='rtf,cpu,scripts',
+    parser.add_argument('--parts', default='rtf,cpu,floor,scripts',
                         help='comma-separated: rtf (max real-time factor), cpu (CPU, memory, start-up), '
+                             'floor (CPU of a bare /clock loop, for scale), '
                              'scripts (the tutorial scripts at factor 1 and 0); default all')
     parser.add_argument('--output', default=os.path.join(demo.ROOT, 'bench_output'))
     args = parser.parse_args(argv)
@@ -262,6 +280,12 @@ def main(argv=None):
             startup.append(started)
             cpu_script.append(measure_cpu_of_script(log_dir, CPU_SCRIPT))
             say('factor 1 while %s drives, run %d: %.1f %% of a core' % (CPU_SCRIPT, run + 1, cpu_script[-1]))
+        floor = dict((physics, []) for physics in ((False, True) if 'floor' in parts else ()))
+        for run in range(args.runs if floor else 0):
+            for physics in floor:
+                floor[physics].append(measure_floor(log_dir, args.cpu_seconds, physics))
+                say('floor%s, run %d: %.1f %% of a core' % (' with physics' if physics else '', run + 1,
+                                                            floor[physics][-1]))
         scripts = {}
         if 'scripts' in parts:
             for factor in (1.0, 0.0):
@@ -286,6 +310,9 @@ def main(argv=None):
                       '%-58s %10.2f s  < %g s: %s' % ('start-up: roslaunch to first odom->base_footprint',
                                                       median(startup), TARGETS['startup'],
                                                       verdict(median(startup) < TARGETS['startup']))]
+        if floor:
+            lines += ['%-58s %11.1f%%' % ('  floor: a python loop paced to 100 Hz publishing /clock', median(floor[False])),
+                      '%-58s %11.1f%%' % ('  floor: the same, a pybullet step each tick', median(floor[True]))]
         if rss:
             lines.append('%-58s %8.0f MiB' % ('peak RSS of the simulator node (max over runs)', max(rss)))
         for script, _ in (demo.SCRIPTS if scripts else []):

@@ -1,0 +1,45 @@
+"""The least a simulator in python can cost at factor 1 here: a loop that
+sleeps to each tick of 1 / physics_rate and publishes /clock, with (--physics)
+or without a pybullet step of the Burger; nothing else. `make bench` measures
+its CPU as it does the simulator's, for scale.
+
+    python3 tools/clock_floor.py [--physics]   (inside `source setup.bash`)
+"""
+import argparse
+import os
+import sys
+
+import rospy
+from rosgraph_msgs.msg import Clock
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, '..', 'src'))
+
+from tb3_sim_nav.pacing import Pacer  # noqa: E402 (after the path)
+from tb3_sim_nav.ros_node import _publisher, _stop_following_clock  # noqa: E402
+from tb3_sim_nav.world import SimWorld  # noqa: E402
+
+PHYSICS_RATE = 100.0  # Hz, the simulator's default
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--physics', action='store_true', help='also step a pybullet Burger each tick')
+    args = parser.parse_args(rospy.myargv()[1:])
+    rospy.init_node('tb3_clock_floor')
+    _stop_following_clock()
+    world = SimWorld(os.path.join(HERE, '..', 'urdf', 'turtlebot3_burger.urdf'),
+                     time_step=1.0 / PHYSICS_RATE) if args.physics else None
+    clock = _publisher('clock', Clock)
+    pacer = Pacer(1.0)
+    steps = 0
+    while not rospy.is_shutdown():
+        steps += 1
+        pacer.wait_until(steps / PHYSICS_RATE)
+        if world:
+            world.step()
+        clock.publish(Clock(clock=rospy.Time(*divmod(steps * int(1e9 / PHYSICS_RATE), 1000000000))))
+
+
+if __name__ == '__main__':
+    main()
