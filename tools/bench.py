@@ -22,13 +22,16 @@ import demo_report
 from demo import Process, say
 from tcpros_reader import TcprosReader
 
-LAUNCH = ['roslaunch', '--wait', 'tb3_sim_bringup', 'tb3_empty_world.launch']
+LAUNCH = ['roslaunch', '--wait', 'tb3_sim_bringup']
+WORLD_WITH_WALLS = 'turtlebot3_world'  # tb3_world.launch's; a param 'world' picks that launch
 TOPICS = ['clock', 'odom', 'tf', 'joint_states', 'base_pose_ground_truth', 'scan', 'imu']
 # Each topic is read by a TcprosReader (nearly free), or in this row by one
 # rospy node, which handles each message in python.
 ROSPY_READER = 'every topic on, read by a rospy node'
 SENSOR_SETS = [('every topic on', {}), ('without scan', {'scan': False}),
-               ('without imu', {'imu': False}), ('without scan and imu', {'scan': False, 'imu': False})]
+               ('without imu', {'imu': False}), ('without scan and imu', {'scan': False, 'imu': False}),
+               # In the empty world no lidar beam can hit anything, and none is cast.
+               ('every topic on, in %s' % WORLD_WITH_WALLS, {'world': WORLD_WITH_WALLS})]
 CPU_SCRIPT = 'odom_out_and_back.py'  # the tutorial script that reads tf
 TARGETS = {'rtf': 30.0, 'cpu': 5.0, 'startup': 3.0, 'speedup': 10.0}
 
@@ -110,7 +113,8 @@ def start_sim(name, log_dir, factor, params=None):
     master = rosgraph.Master('/tb3_bench')
     for key in ('scan', 'imu'):
         master.setParam('/tb3_sim/' + key, (params or {}).get(key, True))
-    return Process(name, LAUNCH + ['real_time_factor:=%g' % factor], log_dir)
+    launch = 'tb3_world.launch' if (params or {}).get('world') == WORLD_WITH_WALLS else 'tb3_empty_world.launch'
+    return Process(name, LAUNCH + [launch, 'real_time_factor:=%g' % factor], log_dir)
 
 
 def wait_until(predicate, timeout, what):
