@@ -23,15 +23,18 @@ from demo import Process, say
 from tcpros_reader import TcprosReader
 
 LAUNCH = ['roslaunch', '--wait', 'tb3_sim_bringup']
-WORLD_WITH_WALLS = 'turtlebot3_world'  # tb3_world.launch's; a param 'world' picks that launch
+EMPTY_WORLD, WALLED_WORLD = 'tb3_empty_world.launch', 'tb3_world.launch'  # the tutorial's two
 TOPICS = ['clock', 'odom', 'tf', 'joint_states', 'base_pose_ground_truth', 'scan', 'imu']
 # Each topic is read by a TcprosReader (nearly free), or in this row by one
 # rospy node, which handles each message in python.
 ROSPY_READER = 'every topic on, read by a rospy node'
-SENSOR_SETS = [('every topic on', {}), ('without scan', {'scan': False}),
-               ('without imu', {'imu': False}), ('without scan and imu', {'scan': False, 'imu': False}),
-               # In the empty world no lidar beam can hit anything, and none is cast.
-               ('every topic on, in %s' % WORLD_WITH_WALLS, {'world': WORLD_WITH_WALLS})]
+# (label, launch file, sensors switched off). In the empty world no lidar
+# beam can hit anything, and none is cast: the walled world casts them.
+SENSOR_SETS = [('every topic on', EMPTY_WORLD, {}),
+               ('without scan', EMPTY_WORLD, {'scan': False}),
+               ('without imu', EMPTY_WORLD, {'imu': False}),
+               ('without scan and imu', EMPTY_WORLD, {'scan': False, 'imu': False}),
+               ('every topic on, in turtlebot3_world', WALLED_WORLD, {})]
 CPU_SCRIPT = 'odom_out_and_back.py'  # the tutorial script that reads tf
 TARGETS = {'rtf': 30.0, 'cpu': 5.0, 'startup': 3.0, 'speedup': 10.0}
 
@@ -107,13 +110,13 @@ class Listener(object):
         self.subscribers = []
 
 
-def start_sim(name, log_dir, factor, params=None):
-    """The tutorial's launch at `factor`; `params` are private parameters of /tb3_sim."""
+def start_sim(name, log_dir, factor, launch=EMPTY_WORLD, sensors=None):
+    """One of the tutorial's launches at `factor`; `sensors` maps 'scan' and
+    'imu' to False to switch them off (private parameters of /tb3_sim)."""
     import rosgraph
     master = rosgraph.Master('/tb3_bench')
     for key in ('scan', 'imu'):
-        master.setParam('/tb3_sim/' + key, (params or {}).get(key, True))
-    launch = 'tb3_world.launch' if (params or {}).get('world') == WORLD_WITH_WALLS else 'tb3_empty_world.launch'
+        master.setParam('/tb3_sim/' + key, (sensors or {}).get(key, True))
     return Process(name, LAUNCH + [launch, 'real_time_factor:=%g' % factor], log_dir)
 
 
@@ -125,15 +128,15 @@ def wait_until(predicate, timeout, what):
         time.sleep(0.01)
 
 
-def measure_rtf(log_dir, params, seconds, rospy_reader=False):
+def measure_rtf(log_dir, launch, sensors, seconds, rospy_reader=False):
     """Sim seconds per wall second at factor 0, and the node's peak RSS. Every
     topic is read by a TcprosReader, or with `rospy_reader` by a rospy node."""
     listener = Listener() if rospy_reader else None
-    sim = start_sim('rtf', log_dir, 0.0, params)
+    sim = start_sim('rtf', log_dir, 0.0, launch, sensors)
     readers = []
     try:
         if listener is None:
-            readers = [TcprosReader(sim_uri, '/' + topic) for topic in TOPICS if params.get(topic, True)]
+            readers = [TcprosReader(sim_uri, '/' + topic) for topic in TOPICS if sensors.get(topic, True)]
             clock = next(reader for reader in readers if reader.topic == '/clock')
         else:
             clock = listener
@@ -261,17 +264,17 @@ def main(argv=None):
         rospy.init_node('tb3_bench', anonymous=True, argv=[sys.argv[0]], disable_signals=True)
         parts = args.parts.split(',')
         rtf, rss = {}, []
-        for label, params in (SENSOR_SETS if 'rtf' in parts else []):
+        for label, launch, sensors in (SENSOR_SETS if 'rtf' in parts else []):
             rtf[label] = []
             for run in range(args.runs):
-                value, peak = measure_rtf(log_dir, params, args.seconds)
+                value, peak = measure_rtf(log_dir, launch, sensors, args.seconds)
                 say('max real-time factor, %s, run %d: %.1f' % (label, run + 1, value))
                 rtf[label].append(value)
                 rss.append(peak)
         if 'rtf' in parts:
             rtf[ROSPY_READER] = []
             for run in range(args.runs):
-                value, peak = measure_rtf(log_dir, {}, args.seconds, rospy_reader=True)
+                value, peak = measure_rtf(log_dir, EMPTY_WORLD, {}, args.seconds, rospy_reader=True)
                 say('max real-time factor, %s, run %d: %.1f' % (ROSPY_READER, run + 1, value))
                 rtf[ROSPY_READER].append(value)
                 rss.append(peak)
@@ -303,7 +306,7 @@ def main(argv=None):
             full = median(rtf['every topic on'])
             lines.append('%-58s %12.1f  >= %g: %s' % ('max real-time factor, headless empty world, every topic on',
                                                      full, TARGETS['rtf'], verdict(full >= TARGETS['rtf'])))
-            for label in [label for label, _ in SENSOR_SETS[1:]] + [ROSPY_READER]:
+            for label in [label for label, _, _ in SENSOR_SETS[1:]] + [ROSPY_READER]:
                 lines.append('%-58s %12.1f' % ('max real-time factor, ' + label, median(rtf[label])))
         if cpu:
             lines += ['%-58s %11.1f%%  < %g %%: %s' % ('CPU of the simulator at factor 1, driving, all topics read',

@@ -16,7 +16,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, '..', 'src'))
 
 from tb3_sim_nav.pacing import Pacer  # noqa: E402 (after the path)
-from tb3_sim_nav.ros_node import _publisher, _stop_following_clock  # noqa: E402
+from tb3_sim_nav.ros_node import stop_following_clock, synchronous_publisher  # noqa: E402
 from tb3_sim_nav.world import SimWorld  # noqa: E402
 
 PHYSICS_RATE = 100.0  # Hz, the simulator's default
@@ -27,10 +27,10 @@ def main():
     parser.add_argument('--physics', action='store_true', help='also step a pybullet Burger each tick')
     args = parser.parse_args(rospy.myargv()[1:])
     rospy.init_node('tb3_clock_floor')
-    _stop_following_clock()
+    stop_following_clock()
     world = SimWorld(os.path.join(HERE, '..', 'urdf', 'turtlebot3_burger.urdf'),
                      time_step=1.0 / PHYSICS_RATE) if args.physics else None
-    clock = _publisher('clock', Clock)
+    clock = synchronous_publisher('clock', Clock)
     pacer = Pacer(1.0)
     steps = 0
     while not rospy.is_shutdown():

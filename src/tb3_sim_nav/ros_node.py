@@ -54,7 +54,7 @@ def _set_quaternion(quaternion, values):
     quaternion.x, quaternion.y, quaternion.z, quaternion.w = values
 
 
-def _publisher(topic, message_class, **options):
+def synchronous_publisher(topic, message_class, **options):
     """A synchronous publisher: publish() writes to every subscriber's socket at once.
 
     rospy's queued publishers hand each message to a writer thread per
@@ -68,7 +68,7 @@ def _publisher(topic, message_class, **options):
         return rospy.Publisher(topic, message_class, queue_size=None, tcp_nodelay=True, **options)
 
 
-def _stop_following_clock():
+def stop_following_clock():
     """Under sim time rospy subscribes every node to /clock, this one too:
     here that would send every tick through a socket back to where it came
     from. Drop that subscription (True); the step loop sets rospy's time."""
@@ -105,16 +105,17 @@ class SimulatorNode(object):
         self._make_messages()
         # Latched: a node that starts gets the time at once, even while paused,
         # not after a data message stamped later (hztest then measures nothing).
-        self.clock_pub = _publisher('clock', Clock, subscriber_listener=_OnSubscribe(self._hold_clock), latch=True)
-        self.odom_pub = _publisher('odom', Odometry)
-        self.truth_pub = _publisher('base_pose_ground_truth', Odometry)
-        self.joints_pub = _publisher('joint_states', JointState)
-        self.tf_pub = _publisher('tf', TFMessage)
-        self.scan_pub = _publisher('scan', LaserScan) if simulation.lidar else None
-        self.imu_pub = _publisher('imu', Imu) if simulation.imu else None
+        self.clock_pub = synchronous_publisher('clock', Clock, latch=True,
+                                               subscriber_listener=_OnSubscribe(self._hold_clock))
+        self.odom_pub = synchronous_publisher('odom', Odometry)
+        self.truth_pub = synchronous_publisher('base_pose_ground_truth', Odometry)
+        self.joints_pub = synchronous_publisher('joint_states', JointState)
+        self.tf_pub = synchronous_publisher('tf', TFMessage)
+        self.scan_pub = synchronous_publisher('scan', LaserScan) if simulation.lidar else None
+        self.imu_pub = synchronous_publisher('imu', Imu) if simulation.imu else None
         self.lockstep = None  # set below; the cmd_vel callback may run before
         cmd_vel = rospy.Subscriber('cmd_vel', Twist, self._on_cmd_vel, queue_size=10, tcp_nodelay=True)
-        self._own_clock = _stop_following_clock()
+        self._own_clock = stop_following_clock()
         # Paced, a step has wall time to spare: look less often, for less CPU.
         factor = config['real_time_factor']
         poll = max(LOCKSTEP_POLL, LOCKSTEP_POLL_SHARE / config['physics_rate'] / factor) if factor else LOCKSTEP_POLL
