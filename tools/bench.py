@@ -25,16 +25,16 @@ from tcpros_reader import TcprosReader
 LAUNCH = ['roslaunch', '--wait', 'tb3_sim_bringup']
 EMPTY_WORLD, WALLED_WORLD = 'tb3_empty_world.launch', 'tb3_world.launch'  # the tutorial's two
 TOPICS = ['clock', 'odom', 'tf', 'joint_states', 'base_pose_ground_truth', 'scan', 'imu']
-# Each topic is read by a TcprosReader (nearly free), or in this row by one
-# rospy node, which handles each message in python.
-ROSPY_READER = 'every topic on, read by a rospy node'
-# (label, launch file, sensors switched off). In the empty world no lidar
-# beam can hit anything, and none is cast: the walled world casts them.
-SENSOR_SETS = [('every topic on', EMPTY_WORLD, {}),
-               ('without scan', EMPTY_WORLD, {'scan': False}),
-               ('without imu', EMPTY_WORLD, {'imu': False}),
-               ('without scan and imu', EMPTY_WORLD, {'scan': False, 'imu': False}),
-               ('every topic on, in turtlebot3_world', WALLED_WORLD, {})]
+# (label, launch file, sensors switched off, read by a rospy node). Each
+# topic is read by a TcprosReader (nearly free), or by one rospy node, which
+# handles each message in python. In the empty world no lidar beam can hit
+# anything, and none is cast: the walled world casts them.
+RTF_ROWS = [('every topic on', EMPTY_WORLD, {}, False),
+            ('without scan', EMPTY_WORLD, {'scan': False}, False),
+            ('without imu', EMPTY_WORLD, {'imu': False}, False),
+            ('without scan and imu', EMPTY_WORLD, {'scan': False, 'imu': False}, False),
+            ('every topic on, in turtlebot3_world', WALLED_WORLD, {}, False),
+            ('every topic on, read by a rospy node', EMPTY_WORLD, {}, True)]
 CPU_SCRIPT = 'odom_out_and_back.py'  # the tutorial script that reads tf
 TARGETS = {'rtf': 30.0, 'cpu': 5.0, 'startup': 3.0, 'speedup': 10.0}
 
@@ -264,19 +264,12 @@ def main(argv=None):
         rospy.init_node('tb3_bench', anonymous=True, argv=[sys.argv[0]], disable_signals=True)
         parts = args.parts.split(',')
         rtf, rss = {}, []
-        for label, launch, sensors in (SENSOR_SETS if 'rtf' in parts else []):
+        for label, launch, sensors, rospy_reader in (RTF_ROWS if 'rtf' in parts else []):
             rtf[label] = []
             for run in range(args.runs):
-                value, peak = measure_rtf(log_dir, launch, sensors, args.seconds)
+                value, peak = measure_rtf(log_dir, launch, sensors, args.seconds, rospy_reader)
                 say('max real-time factor, %s, run %d: %.1f' % (label, run + 1, value))
                 rtf[label].append(value)
-                rss.append(peak)
-        if 'rtf' in parts:
-            rtf[ROSPY_READER] = []
-            for run in range(args.runs):
-                value, peak = measure_rtf(log_dir, EMPTY_WORLD, {}, args.seconds, rospy_reader=True)
-                say('max real-time factor, %s, run %d: %.1f' % (ROSPY_READER, run + 1, value))
-                rtf[ROSPY_READER].append(value)
                 rss.append(peak)
         cpu, cpu_script, startup = [], [], []
         for run in range(args.runs if 'cpu' in parts else 0):
@@ -306,7 +299,7 @@ def main(argv=None):
             full = median(rtf['every topic on'])
             lines.append('%-58s %12.1f  >= %g: %s' % ('max real-time factor, headless empty world, every topic on',
                                                      full, TARGETS['rtf'], verdict(full >= TARGETS['rtf'])))
-            for label in [label for label, _, _ in SENSOR_SETS[1:]] + [ROSPY_READER]:
+            for label, _, _, _ in RTF_ROWS[1:]:
                 lines.append('%-58s %12.1f' % ('max real-time factor, ' + label, median(rtf[label])))
         if cpu:
             lines += ['%-58s %11.1f%%  < %g %%: %s' % ('CPU of the simulator at factor 1, driving, all topics read',
