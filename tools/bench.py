@@ -5,7 +5,7 @@ prints medians over several runs, with the machine and the date, and marks
 each figure against its target. It starts one master on a free loopback port
 and stops everything it starts by process group (the demo's machinery).
 
-    python3 tools/bench.py [--runs N] [--parts rtf,cpu,scripts]
+    python3 tools/bench.py [--runs N] [--parts rtf,cpu,floor,scripts]
 """
 import argparse
 import datetime
