@@ -16,8 +16,10 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, '..', 'src'))
 
 from tb3_sim_nav.pacing import Pacer  # noqa: E402 (after the path)
-from tb3_sim_nav.ros_node import stop_following_clock, synchronous_publisher  # noqa: E402
-from tb3_sim_nav.world import SimWorld  # noqa: E402
+from tb3_sim_nav.ros.publishers import Publishers  # noqa: E402
+from tb3_sim_nav.ros.rospy_internals import stop_following_clock  # noqa: E402
+from tb3_sim_nav.throttle import Throttle  # noqa: E402
+from tb3_sim_nav.world import World  # noqa: E402
 
 PHYSICS_RATE = 100.0  # Hz, the simulator's default
 
@@ -28,9 +30,10 @@ def main():
     args = parser.parse_args(rospy.myargv()[1:])
     rospy.init_node('tb3_clock_floor')
     stop_following_clock()
-    world = SimWorld(os.path.join(HERE, '..', 'urdf', 'turtlebot3_burger.urdf'),
-                     time_step=1.0 / PHYSICS_RATE) if args.physics else None
-    clock = synchronous_publisher('clock', Clock)
+    world = World(time_step=1.0 / PHYSICS_RATE) if args.physics else None
+    if world:
+        world.add_robot(os.path.join(HERE, '..', 'urdf', 'turtlebot3_burger.urdf'), (0.0, 0.0, 0.0, 0.0))
+    clock = Publishers(Throttle(10.0)).advertise('clock', Clock)
     pacer = Pacer(1.0)
     steps = 0
     while not rospy.is_shutdown():

@@ -3,7 +3,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src'))
-from tb3_sim_nav.params import PARAMETERS, PROFILES  # noqa: E402
+from tb3_sim_nav.params import FROM_MODEL, FROM_PROFILE, PARAMETERS, PROFILES  # noqa: E402
 
 
 def shown(value):
@@ -18,9 +18,13 @@ def main():
     for parameter in PARAMETERS:
         if parameter.name == 'urdf_file':
             default = '(set by the launch)'
-        elif parameter.default is None:
+        elif parameter.origin == FROM_MODEL:
+            default = "the model's (its URDF's `<drive_limits>`)"
+        elif parameter.origin == FROM_PROFILE:
             default = ', '.join('%s: %s' % (profile, shown(PROFILES[profile][parameter.name]))
                                 for profile in sorted(PROFILES))
+        elif parameter.default == ():
+            default = '(none)'
         else:
             default = shown(parameter.default)
         print('| `~%s` | %s | %s | %s |' % (parameter.name, default, parameter.unit, parameter.doc))

@@ -1,17 +1,25 @@
-"""The simulator's private parameters: defaults, units, validation.
+"""The simulator's private parameters: a typed, frozen Config, with defaults, units, validation.
 
 `resolve(lookup)` reads each parameter once through `lookup(name, default)`
-(rospy.get_param on '~name' in the node, a dict in tests) and returns them
-checked, or raises ParameterError naming the parameter and the value.
+(rospy.get_param on '~name' in the node, a dict in tests) and returns a
+Config, checked, or raises ParameterError naming the parameter and the value.
 
 A realism profile (`~profile`) only chooses defaults: every knob it sets is
-a parameter of its own, and a value given explicitly wins.
+a parameter of its own, and a value given explicitly wins. The drive's
+limits default to the robot model's own (its URDF's <drive_limits>).
 """
+import dataclasses
 import math
 import os
-from collections import OrderedDict, namedtuple
+from collections import namedtuple
+from typing import Optional
 
-Parameter = namedtuple('Parameter', 'name default kind check unit doc')
+from .world_file import WorldError, parse_robots
+
+Parameter = namedtuple('Parameter', 'name default kind check unit doc origin')
+
+#: Where a default comes from when the field's default is None.
+FROM_PROFILE, FROM_MODEL = 'profile', 'model'
 
 
 class ParameterError(ValueError):
@@ -28,10 +36,6 @@ def _non_negative(value):
 
 def _fraction(value):
     return None if -0.5 < value < 0.5 else 'must be between -0.5 and 0.5'
-
-
-def _existing_file(value):
-    return None if os.path.isfile(value) else 'no such file'
 
 
 def _frame_id(value):
@@ -54,6 +58,14 @@ def _at_least(minimum):
     return check
 
 
+def _robots(value):
+    try:
+        parse_robots(value, 'the list')
+    except WorldError as error:
+        return str(error)
+    return None
+
+
 #: The defaults each profile gives its knobs. 'gazebo' is TurtleBot3's
 #: Gazebo set-up: perfect odometry, no slip, commands held forever;
 #: 'realistic' is closer to a real Burger on a floor.
@@ -70,60 +82,86 @@ PROFILES = {
                       imu_gyro_noise=2e-3, imu_accel_noise=5e-2),
 }
 
-PARAMETERS = [
-    Parameter('urdf_file', '', str, _existing_file, '', 'URDF of the robot, loaded into pybullet; wheel geometry comes from it'),
-    Parameter('world', 'empty', str, None, '', 'world by name (worlds/NAME.yaml) or path to a world file'),
-    Parameter('x_pos', 0.0, float, None, 'm', 'spawn position x'),
-    Parameter('y_pos', 0.0, float, None, 'm', 'spawn position y'),
-    Parameter('z_pos', 0.0, float, None, 'm', 'spawn height of base_footprint'),
-    Parameter('yaw', 0.0, float, None, 'rad', 'spawn heading'),
-    Parameter('gui', False, bool, None, '', "open pybullet's own window (needs a display)"),
-    Parameter('real_time_factor', 1.0, float, _non_negative, '', 'simulated seconds per wall second; 0 = as fast as possible'),
-    Parameter('paused', False, bool, None, '', 'start with physics paused (/gazebo/unpause_physics resumes)'),
-    Parameter('physics_rate', 100.0, float, _positive, 'Hz', 'physics steps per simulated second; /clock is published every step (Gazebo publishes it at 100 Hz)'),
-    Parameter('lockstep', True, bool, None, '', 'hold each step until the local nodes publishing cmd_vel have reacted to it, so their commands land at the same sim time at any factor'),
-    Parameter('lockstep_timeout', 0.5, float, _positive, 's (wall)', 'longest a step waits for such a node; one that takes longer is not waited for until it waits again'),
-    Parameter('startup_hold', 0.3, float, _non_negative, 's (wall)', 'sim time holds this long when a node subscribes to /clock, so it can connect first'),
-    Parameter('odom_rate', 30.0, float, _positive, 'Hz', 'rate of odom, tf and base_pose_ground_truth (sim time)'),
-    Parameter('joint_states_rate', 30.0, float, _positive, 'Hz', 'rate of joint_states (sim time)'),
-    Parameter('max_linear_speed', 0.22, float, _positive, 'm/s', 'commands beyond this are clamped'),
-    Parameter('max_angular_speed', 2.84, float, _positive, 'rad/s', 'commands beyond this are clamped'),
-    Parameter('wheel_torque', 1.5, float, _positive, 'N m', 'stall torque of each wheel motor (Dynamixel XL430 at 12 V)'),
-    Parameter('wheel_acceleration', 1.0, float, _non_negative, 'm/s^2', "limit on each wheel rim's acceleration, as TurtleBot3's Gazebo set-up (wheelAcceleration 1); 0 = none"),
-    Parameter('odom_frame', 'odom', str, _frame_id, '', 'frame of odom and of its tf parent'),
-    Parameter('base_frame', 'base_footprint', str, _frame_id, '', 'child frame of odom and its tf'),
-    Parameter('scan', True, bool, None, '', 'publish the LDS-01 lidar on scan'),
-    Parameter('scan_rate', 5.0, float, _positive, 'Hz', 'scan rate (sim time)'),
-    Parameter('scan_samples', 360, int, _at_least(3), '', 'beams per turn'),
-    Parameter('scan_range_min', 0.12, float, _non_negative, 'm', 'closer hits read -inf'),
-    Parameter('scan_range_max', 3.5, float, _positive, 'm', 'beams reaching no wall within it read +inf'),
-    Parameter('scan_noise', 0.01, float, _non_negative, 'm', 'standard deviation of Gaussian range noise; 0 = none'),
-    Parameter('imu', True, bool, None, '', 'publish the IMU on imu'),
-    Parameter('imu_rate', 100.0, float, _positive, 'Hz', 'IMU rate (sim time); at most ~physics_rate: the real Burger and its Gazebo model give 200 Hz, with ~physics_rate 200'),
-    Parameter('seed', -1, int, _at_least(-1), '', 'seed of every noise source; -1 = different each run'),
-    Parameter('profile', 'gazebo', str, _one_of(*sorted(PROFILES)), '', 'realism profile: chooses the defaults below'),
-    Parameter('odom_source', None, str, _one_of('world', 'encoders'), '', 'odom from the true pose (Gazebo) or integrated from wheel encoders (firmware)'),
-    Parameter('ground_friction', None, float, _positive, '', 'Coulomb friction of wheel on ground'),
-    Parameter('caster_friction', None, float, _non_negative, '', 'Coulomb friction of the ball caster on ground (drags when turning)'),
-    Parameter('left_motor_error', None, float, _fraction, 'fraction', 'the left wheel turns this much faster than commanded (negative: slower), as a loaded motor does'),
-    Parameter('right_motor_error', None, float, _fraction, 'fraction', 'the same for the right wheel'),
-    Parameter('odom_wheel_radius_error', None, float, _fraction, 'fraction', 'encoder odometry assumes a wheel this much bigger than the real one'),
-    Parameter('odom_wheel_separation_error', None, float, _fraction, 'fraction', 'encoder odometry assumes wheels this much further apart than they act'),
-    Parameter('encoder_noise', None, float, _non_negative, 'rad', 'standard deviation of Gaussian noise on each wheel-angle reading'),
-    Parameter('cmd_vel_timeout', None, float, _non_negative, 's', 'stop when no cmd_vel came for this long (firmware: 0.5); 0 = hold the last command forever'),
-    Parameter('imu_gyro_noise', None, float, _non_negative, 'rad/s', 'standard deviation of angular-velocity noise'),
-    Parameter('imu_accel_noise', None, float, _non_negative, 'm/s^2', 'standard deviation of linear-acceleration noise'),
-]
+
+def _p(default, doc, check=None, unit='', origin=None):
+    return dataclasses.field(default=default, metadata=dict(check=check, unit=unit, doc=doc, origin=origin))
+
+
+@dataclasses.dataclass(frozen=True)
+class Config(object):
+    """Every parameter of the simulator node, resolved and checked."""
+    urdf_file: str = _p('', 'URDF of the robot (when ~robots is empty), loaded into pybullet; wheel geometry and limits come from it')
+    robots: tuple = _p((), 'robots with namespaces, instead of the one robot of ~urdf_file: a list of {name, model, position: [x, y(, z)], yaw} as in world files', _robots)
+    world: str = _p('empty', 'world by name (worlds/NAME.yaml) or path to a world file')
+    x_pos: float = _p(0.0, 'spawn position x', unit='m')
+    y_pos: float = _p(0.0, 'spawn position y', unit='m')
+    z_pos: float = _p(0.0, 'spawn height of base_footprint', unit='m')
+    yaw: float = _p(0.0, 'spawn heading', unit='rad')
+    gui: bool = _p(False, "open pybullet's own window (needs a display)")
+    real_time_factor: float = _p(1.0, 'simulated seconds per wall second; 0 = as fast as possible', _non_negative)
+    paused: bool = _p(False, 'start with physics paused (/gazebo/unpause_physics resumes)')
+    physics_rate: float = _p(100.0, 'physics steps per simulated second; /clock is published every step (Gazebo publishes it at 100 Hz)', _positive, 'Hz')
+    lockstep: bool = _p(True, 'hold each step until the local nodes publishing cmd_vel have reacted to it, so their commands land at the same sim time at any factor')
+    lockstep_timeout: float = _p(0.5, 'longest a step waits for such a node; one that takes longer is not waited for until it waits again', _positive, 's (wall)')
+    startup_hold: float = _p(0.3, 'sim time holds this long when a node subscribes to /clock, so it can connect first', _non_negative, 's (wall)')
+    odom_rate: float = _p(30.0, 'rate of odom, tf and base_pose_ground_truth (sim time)', _positive, 'Hz')
+    joint_states_rate: float = _p(30.0, 'rate of joint_states (sim time)', _positive, 'Hz')
+    max_linear_speed: Optional[float] = _p(None, 'commands beyond this are clamped', _positive, 'm/s', FROM_MODEL)
+    max_angular_speed: Optional[float] = _p(None, 'commands beyond this are clamped', _positive, 'rad/s', FROM_MODEL)
+    wheel_torque: float = _p(1.5, 'stall torque of each wheel motor (Dynamixel XL430 at 12 V)', _positive, 'N m')
+    wheel_acceleration: float = _p(1.0, "limit on each wheel rim's acceleration, as TurtleBot3's Gazebo set-up (wheelAcceleration 1); 0 = none", _non_negative, 'm/s^2')
+    odom_frame: str = _p('odom', 'frame of odom and of its tf parent (a robot with a name gets it as a prefix: tb3_0/odom)', _frame_id)
+    base_frame: str = _p('base_footprint', 'child frame of odom and its tf (prefixed as odom_frame)', _frame_id)
+    robot_state_publisher: bool = _p(True, 'start a robot_state_publisher (with tf_prefix) for each robot with a name, and set its NAME/robot_description')
+    scan: bool = _p(True, 'publish the LDS-01 lidar on scan')
+    scan_rate: float = _p(5.0, 'scan rate (sim time)', _positive, 'Hz')
+    scan_samples: int = _p(360, 'beams per turn', _at_least(3))
+    scan_range_min: float = _p(0.12, 'closer hits read -inf', _non_negative, 'm')
+    scan_range_max: float = _p(3.5, 'beams reaching no wall within it read +inf', _positive, 'm')
+    scan_noise: float = _p(0.01, 'standard deviation of Gaussian range noise; 0 = none', _non_negative, 'm')
+    imu: bool = _p(True, 'publish the IMU on imu')
+    imu_rate: float = _p(100.0, 'IMU rate (sim time); at most ~physics_rate: the real Burger and its Gazebo model give 200 Hz, with ~physics_rate 200', _positive, 'Hz')
+    seed: int = _p(-1, 'seed of every noise source; -1 = different each run', _at_least(-1))
+    profile: str = _p('gazebo', 'realism profile: chooses the defaults below', _one_of(*sorted(PROFILES)))
+    odom_source: str = _p(None, 'odom from the true pose (Gazebo) or integrated from wheel encoders (firmware)', _one_of('world', 'encoders'), origin=FROM_PROFILE)
+    ground_friction: float = _p(None, 'Coulomb friction of wheel on ground', _positive, origin=FROM_PROFILE)
+    caster_friction: float = _p(None, 'Coulomb friction of the ball caster on ground (drags when turning)', _non_negative, origin=FROM_PROFILE)
+    left_motor_error: float = _p(None, 'the left wheel turns this much faster than commanded (negative: slower), as a loaded motor does', _fraction, 'fraction', FROM_PROFILE)
+    right_motor_error: float = _p(None, 'the same for the right wheel', _fraction, 'fraction', FROM_PROFILE)
+    odom_wheel_radius_error: float = _p(None, 'encoder odometry assumes a wheel this much bigger than the real one', _fraction, 'fraction', FROM_PROFILE)
+    odom_wheel_separation_error: float = _p(None, 'encoder odometry assumes wheels this much further apart than they act', _fraction, 'fraction', FROM_PROFILE)
+    encoder_noise: float = _p(None, 'standard deviation of Gaussian noise on each wheel-angle reading', _non_negative, 'rad', FROM_PROFILE)
+    cmd_vel_timeout: float = _p(None, 'stop when no cmd_vel came for this long (firmware: 0.5); 0 = hold the last command forever', _non_negative, 's', FROM_PROFILE)
+    imu_gyro_noise: float = _p(None, 'standard deviation of angular-velocity noise', _non_negative, 'rad/s', FROM_PROFILE)
+    imu_accel_noise: float = _p(None, 'standard deviation of linear-acceleration noise', _non_negative, 'm/s^2', FROM_PROFILE)
+
+    def replace(self, **changes):
+        """A copy with `changes` (unchecked: for tests and tools)."""
+        return dataclasses.replace(self, **changes)
+
+
+def _kind(field):
+    return float if field.type == Optional[float] else field.type
+
+
+#: The parameters in the node's order, for the README table and the tests.
+PARAMETERS = [Parameter(field.name, field.default, _kind(field), field.metadata['check'], field.metadata['unit'],
+                        field.metadata['doc'], field.metadata['origin'])
+              for field in dataclasses.fields(Config)]
 
 
 def _typed(parameter, value):
     """`value` as the parameter's type, or ParameterError."""
     kind = parameter.kind
+    if value is None and parameter.origin == FROM_MODEL:
+        return None
     if isinstance(value, bool) != (kind is bool):
         pass  # a bool is an int in python, but never a number here
     elif kind is float and isinstance(value, (int, float)) and math.isfinite(value):
         return float(value)
-    elif kind is not float and isinstance(value, kind):
+    elif kind is tuple and isinstance(value, (list, tuple)):
+        return tuple(value)
+    elif kind not in (float, tuple) and isinstance(value, kind):
         return value
     raise ParameterError('parameter ~%s = %r (%s): must be a%s %s'
                          % (parameter.name, value, type(value).__name__,
@@ -131,17 +169,19 @@ def _typed(parameter, value):
 
 
 def resolve(lookup, parameters=PARAMETERS):
-    """Every parameter, checked: an OrderedDict name -> value."""
-    resolved = OrderedDict()
+    """Every parameter, checked: a Config."""
+    resolved = {}
     for parameter in parameters:
         default = parameter.default
-        if default is None:  # a knob of the realism profile
+        if parameter.origin == FROM_PROFILE:
             default = PROFILES[resolved['profile']][parameter.name]
         value = _typed(parameter, lookup(parameter.name, default))
-        problem = parameter.check(value) if parameter.check else None
+        problem = parameter.check(value) if parameter.check and value is not None else None
         if problem:
             raise ParameterError('parameter ~%s = %r: %s' % (parameter.name, value, problem))
         resolved[parameter.name] = value
+    if not resolved['robots'] and not os.path.isfile(resolved['urdf_file']):
+        raise ParameterError('parameter ~urdf_file = %r: no such file' % resolved['urdf_file'])
     for rate in ('odom_rate', 'joint_states_rate', 'scan_rate', 'imu_rate'):
         if resolved[rate] > resolved['physics_rate']:
             raise ParameterError('parameter ~%s = %r: must not exceed ~physics_rate = %r'
@@ -149,4 +189,5 @@ def resolve(lookup, parameters=PARAMETERS):
     if resolved['scan_range_min'] >= resolved['scan_range_max']:
         raise ParameterError('parameter ~scan_range_min = %r: must be below ~scan_range_max = %r'
                              % (resolved['scan_range_min'], resolved['scan_range_max']))
-    return resolved
+    resolved['robots'] = tuple(parse_robots(resolved['robots']))
+    return Config(**resolved)

@@ -1,10 +1,19 @@
-"""Drive geometry read from the robot's URDF: the one source of truth."""
+"""A robot model read from its URDF: drive geometry, limits, casters. The one source of truth.
+
+The simulator knows a TurtleBot3 only through its URDF: the wheels' radius
+and separation from the wheel joints and links, the drive's limits from the
+element <drive_limits max_linear_speed=".." max_angular_speed=".."/>, the
+ball casters from their link names.
+"""
 import os
 import xml.etree.ElementTree as ElementTree
 from collections import namedtuple
 
+from .diff_drive import Limits
+
 LEFT_WHEEL_JOINT = 'wheel_left_joint'
 RIGHT_WHEEL_JOINT = 'wheel_right_joint'
+CASTER_PREFIX = 'caster_'  # ball casters: links named caster_back_link, caster_back_left_link...
 
 # pybullet reports a multibody's base pose at the base's centre of mass, and
 # gives a link without <inertial> 1 kg: the root gets this tiny one at its origin.
@@ -12,6 +21,9 @@ ROOT_INERTIAL = ('<inertial><origin xyz="0 0 0" rpy="0 0 0"/><mass value="0.001"
                  '<inertia ixx="1e-7" ixy="0" ixz="0" iyy="1e-7" iyz="0" izz="1e-7"/></inertial>')
 
 DriveGeometry = namedtuple('DriveGeometry', 'wheel_radius wheel_separation')
+
+#: Everything the simulator takes from a robot's URDF.
+RobotModel = namedtuple('RobotModel', 'urdf_file name geometry limits casters')
 
 
 class ModelError(ValueError):
@@ -49,9 +61,7 @@ def urdf_for_pybullet(urdf_path):
     return ElementTree.tostring(robot, encoding='unicode')
 
 
-def read_drive_geometry(urdf_path):
-    """Wheel radius (m) and separation (m) of a two-wheeled URDF."""
-    robot = _parse(urdf_path)
+def _drive_geometry(robot, urdf_path):
     joints = {joint.get('name'): joint for joint in robot.iter('joint')}
     links = {link.get('name'): link for link in robot.iter('link')}
     origins, radii = [], []
@@ -79,3 +89,50 @@ def read_drive_geometry(urdf_path):
     if separation <= 0.0:
         raise ModelError('URDF file %r: the wheels are not apart along y' % urdf_path)
     return DriveGeometry(wheel_radius=radii[0], wheel_separation=separation)
+
+
+def read_drive_geometry(urdf_path):
+    """Wheel radius (m) and separation (m) of a two-wheeled URDF."""
+    return _drive_geometry(_parse(urdf_path), urdf_path)
+
+
+def _limits(robot, urdf_path):
+    element = robot.find('drive_limits')
+    if element is None:
+        raise ModelError('URDF file %r has no <drive_limits max_linear_speed="..." max_angular_speed="..."/> '
+                         '(m/s, rad/s): add one, as urdf/turtlebot3_burger.urdf has' % urdf_path)
+    values = []
+    for name in ('max_linear_speed', 'max_angular_speed'):
+        try:
+            value = float(element.get(name))
+        except (TypeError, ValueError):
+            value = None
+        if value is None or not value > 0.0 or value == float('inf'):
+            raise ModelError('URDF file %r: <drive_limits %s=%r> must be a number > 0'
+                             % (urdf_path, name, element.get(name)))
+        values.append(value)
+    return Limits(*values)
+
+
+def load_model(urdf_path):
+    """The RobotModel of a URDF file, or ModelError naming the file and what it lacks."""
+    robot = _parse(urdf_path)
+    casters = tuple(sorted(link.get('name') for link in robot.iter('link')
+                           if link.get('name', '').startswith(CASTER_PREFIX)))
+    return RobotModel(urdf_file=urdf_path, name=robot.get('name', ''),
+                      geometry=_drive_geometry(robot, urdf_path), limits=_limits(robot, urdf_path),
+                      casters=casters)
+
+
+#: The TurtleBot3 family, as TURTLEBOT3_MODEL names it.
+TURTLEBOT3_MODELS = ('burger', 'waffle', 'waffle_pi')
+
+
+def model_urdf(model, urdf_folder):
+    """The URDF file of a model given by TurtleBot3 name (in `urdf_folder`) or by path."""
+    if os.sep in model or model.endswith('.urdf'):
+        return os.path.abspath(os.path.expanduser(model))
+    if model not in TURTLEBOT3_MODELS:
+        raise ModelError('unknown TurtleBot3 model %r: the models are %s (or give the path of a URDF)'
+                         % (model, ', '.join(TURTLEBOT3_MODELS)))
+    return os.path.join(urdf_folder, 'turtlebot3_%s.urdf' % model)

@@ -1,7 +1,13 @@
-"""The pybullet world: a ground plane and the robot, stepped on request.
+"""The pybullet world: a ground plane, static obstacles and robot bodies, stepped on request.
 
 The world knows nothing of ROS, time pacing or I/O; callers set wheel speeds,
 step, and read poses and joint states.
+
+Each robot's links carry a collision-filter group bit of their own (bits 2 to
+31: Bullet's default groups are 1 for dynamic and 2 for static bodies), and
+nothing else changes what collides with what. A robot's lidar casts its rays
+with every bit but its own, so it sees the ground, obstacles and the other
+robots, never itself.
 """
 import math
 import os
@@ -15,24 +21,26 @@ from .robot_model import LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT, urdf_for_pybullet
 
 GRAVITY = 9.81           # m/s^2
 GROUND_FRICTION = 1.0    # rubber tyre on a hard floor
-CASTER_LINK = 'caster_back_link'
 BODY_FRICTION = 0.3      # plastic plates against a wall
 STATIC_BODIES = 2        # Bullet's collision group of bodies with mass 0
+ROBOT_GROUPS = range(2, 32)  # the collision-group bits robots get, one each
+MAX_ROBOTS = len(ROBOT_GROUPS)
 
 
-class SimWorld(object):
-    """A TurtleBot3 on a plane, in its own pybullet client."""
+def _int32(bits):
+    """`bits` (0..2**32-1) as the signed 32-bit int pybullet's C API takes."""
+    return bits - (1 << 32) if bits >= 1 << 31 else bits
 
-    def __init__(self, urdf_path, spawn_pose=(0.0, 0.0, 0.0, 0.0), time_step=1.0 / 200,
-                 wheel_torque=1.5, gui=False, obstacles=(), ground_friction=GROUND_FRICTION,
-                 caster_friction=0.0):
+
+class World(object):
+    """Ground, obstacles and robots, in a pybullet client of their own."""
+
+    def __init__(self, time_step=1.0 / 200, obstacles=(), gui=False):
         self.time_step = time_step
-        self.wheel_torque = wheel_torque
-        self._spawn_pose = spawn_pose
+        self.gui = gui
         self.client = pybullet.connect(pybullet.GUI if gui else pybullet.DIRECT)
         if self.client < 0:
-            raise RuntimeError('pybullet could not open a %s connection'
-                               % ('GUI' if gui else 'DIRECT'))
+            raise RuntimeError('pybullet could not open a %s connection' % ('GUI' if gui else 'DIRECT'))
         self._call = dict(physicsClientId=self.client)
         if gui:  # building a world while it renders takes many seconds
             pybullet.configureDebugVisualizer(pybullet.COV_ENABLE_RENDERING, 0, **self._call)
@@ -42,33 +50,11 @@ class SimWorld(object):
         self.plane = pybullet.createMultiBody(0, plane_shape, **self._call)
         pybullet.changeDynamics(self.plane, -1, lateralFriction=1.0, **self._call)
         self.obstacles = [self._add_obstacle(obstacle) for obstacle in obstacles]
+        self.obstacle_specs = list(obstacles)
         # Obstacles never move: their bounding boxes, once, for cast_rays.
         boxes = [pybullet.getAABB(body, **self._call) for body in self.obstacles]
         self._obstacle_boxes = tuple(np.array([box[end] for box in boxes]).reshape(-1, 3) for end in (0, 1))
-        self.robot = self._load_robot(urdf_path, spawn_pose)
-        links = self._link_indices()
-        self.wheels = [links[LEFT_WHEEL_JOINT], links[RIGHT_WHEEL_JOINT]]
-        # Bullet multiplies the two bodies' coefficients: the plane's is 1, so
-        # these are the coefficients of wheel and caster on the ground.
-        for wheel in self.wheels:
-            pybullet.changeDynamics(self.robot, wheel, lateralFriction=ground_friction,
-                                    rollingFriction=0.0, spinningFriction=0.0, **self._call)
-        # The plastic body slides along a wall rather than gripping it.
-        for link in [-1] + [index for name, index in links.items()
-                            if index not in self.wheels and name != CASTER_LINK]:
-            pybullet.changeDynamics(self.robot, link, lateralFriction=BODY_FRICTION, **self._call)
-        # With no friction the ball caster carries weight but never steers the robot.
-        pybullet.changeDynamics(self.robot, links[CASTER_LINK], lateralFriction=caster_friction,
-                                rollingFriction=0.0, spinningFriction=0.0, **self._call)
-        self.links = links
-        self.set_wheel_speeds(0.0, 0.0)
-        if gui:
-            self._aim_camera(spawn_pose)
-        try:
-            self._check_spawn_is_clear(spawn_pose)
-        except ValueError:
-            self.close()
-            raise
+        self.robots = []
 
     def _add_obstacle(self, obstacle):
         """A static body (mass 0) for a world_file.Obstacle."""
@@ -88,6 +74,45 @@ class SimWorld(object):
         pybullet.changeDynamics(body, -1, lateralFriction=GROUND_FRICTION, **self._call)
         return body
 
+    # --- robots ---------------------------------------------------------------
+    def add_robot(self, urdf_path, pose, name='robot', casters=(), wheel_torque=1.5,
+                  ground_friction=GROUND_FRICTION, caster_friction=0.0):
+        """A RobotBody loaded at `pose` (x, y, z, yaw), or ValueError when the pose
+        puts it inside an obstacle or another robot (the message names both)."""
+        free = sorted(set(ROBOT_GROUPS) - set(robot.group for robot in self.robots))
+        if not free:
+            raise ValueError('robot %s: a world holds at most %d robots' % (name, MAX_ROBOTS))
+        body = RobotBody(self, urdf_path, pose, name, 1 << free[0], casters, wheel_torque,
+                         ground_friction, caster_friction)
+        try:
+            self._check_clear(body, pose)
+        except ValueError:
+            body.remove()
+            raise
+        self.robots.append(body)
+        if self.gui and len(self.robots) == 1:
+            self._aim_camera(pose)
+        return body
+
+    def remove_robot(self, body):
+        self.robots.remove(body)
+        body.remove()
+
+    def _check_clear(self, body, pose):
+        x, y = pose[:2]
+        for index, obstacle in enumerate(self.obstacles):
+            if pybullet.getClosestPoints(body.id, obstacle, 0.0, **self._call):
+                centre = pybullet.getBasePositionAndOrientation(obstacle, **self._call)[0]
+                raise ValueError('robot %s: the spawn pose (%.2f, %.2f) puts it inside obstacle %d of '
+                                 'the world, centred at (%.2f, %.2f): choose another pose'
+                                 % (body.name, x, y, index + 1, centre[0], centre[1]))
+        for other in self.robots:
+            if pybullet.getClosestPoints(body.id, other.id, 0.0, **self._call):
+                there = other.base_pose()[0]
+                raise ValueError('robot %s: the spawn pose (%.2f, %.2f) puts it inside robot %s, '
+                                 'at (%.2f, %.2f): choose another pose'
+                                 % (body.name, x, y, other.name, there[0], there[1]))
+
     def _aim_camera(self, spawn_pose):
         """pybullet's window: no side panels, looking over the robot's shoulder, as demo.rviz."""
         pybullet.configureDebugVisualizer(pybullet.COV_ENABLE_GUI, 0, **self._call)
@@ -97,17 +122,80 @@ class SimWorld(object):
         pybullet.resetDebugVisualizerCamera(cameraDistance=3.0, cameraYaw=math.degrees(yaw) - 70.0,
                                             cameraPitch=-35.0, cameraTargetPosition=ahead, **self._call)
 
-    def _check_spawn_is_clear(self, spawn_pose):
-        for index, body in enumerate(self.obstacles):
-            if pybullet.getClosestPoints(self.robot, body, 0.0, **self._call):
-                x, y = spawn_pose[:2]
-                raise ValueError('the spawn pose (%.2f, %.2f) puts the robot inside obstacle %d of '
-                                 'the world, centred at (%.2f, %.2f): choose another x_pos/y_pos'
-                                 % ((x, y, index + 1) + tuple(
-                                     pybullet.getBasePositionAndOrientation(body, **self._call)[0][:2])))
+    # --- stepping and sensing ---------------------------------------------------
+    def step(self):
+        pybullet.stepSimulation(**self._call)
 
-    def _load_robot(self, urdf_path, spawn_pose):
-        x, y, z, yaw = spawn_pose
+    def cast_rays(self, origin, ends, ignore=None):
+        """Hit fraction of each ray from `origin` (3) to `ends` (N x 3), inf where it
+        hits nothing; the robot body `ignore` is transparent to them.
+
+        Rays that cannot reach anything are not cast: pybullet builds python
+        tuples for every ray, which in the open costs more than the cast.
+        """
+        fractions = np.full(len(ends), math.inf)
+        cast = self._may_hit(np.asarray(origin, dtype=float), ends, ignore)
+        if cast.any():
+            mask = _int32(0xFFFFFFFF & ~(ignore.group if ignore is not None else 0))
+            starts = np.broadcast_to(origin, ends.shape)[cast]
+            hits = pybullet.rayTestBatch(starts, ends[cast], numThreads=1, collisionFilterMask=mask,
+                                         **self._call)
+            fractions[cast] = [hit[2] if hit[0] >= 0 else math.inf for hit in hits]
+        return fractions
+
+    def _may_hit(self, origin, ends, ignore):
+        """Per ray, False only if it can hit nothing: with an obstacle's bounding
+        box or another robot's bounding sphere within reach, every ray may (most
+        then hit something); without, only those that reach the ground (z = 0)."""
+        reach = np.sqrt(((ends - origin) ** 2).sum(axis=1).max())
+        low, high = self._obstacle_boxes  # K x 3 each
+        gaps = np.linalg.norm(np.maximum(np.maximum(low - origin, origin - high), 0.0), axis=1)
+        near = origin[2] <= 0.0 or np.any(gaps <= reach) or any(
+            math.dist(origin, robot.base_pose()[0]) - robot.radius <= reach
+            for robot in self.robots if robot is not ignore)
+        if near:
+            return np.ones(len(ends), dtype=bool)
+        return ends[:, 2] <= 0.0
+
+    def close(self):
+        if pybullet.isConnected(self.client):
+            pybullet.disconnect(self.client)
+
+
+class RobotBody(object):
+    """One robot's multibody in a World: its wheels' motors, its poses and joint states."""
+
+    def __init__(self, world, urdf_path, pose, name, group, casters, wheel_torque, ground_friction,
+                 caster_friction):
+        self.world = world
+        self.name = name
+        self.group = group
+        self.wheel_torque = wheel_torque
+        self._call = world._call
+        self.id = self._load(urdf_path, pose)
+        links = self._link_indices()
+        self.links = links
+        self.wheels = [links[LEFT_WHEEL_JOINT], links[RIGHT_WHEEL_JOINT]]
+        # Bullet multiplies the two bodies' coefficients: the plane's is 1, so
+        # these are the coefficients of wheel and caster on the ground.
+        for wheel in self.wheels:
+            pybullet.changeDynamics(self.id, wheel, lateralFriction=ground_friction,
+                                    rollingFriction=0.0, spinningFriction=0.0, **self._call)
+        caster_links = [links[name] for name in casters if name in links]
+        # The plastic body slides along a wall rather than gripping it.
+        for link in set([-1] + list(links.values())) - set(self.wheels) - set(caster_links):
+            pybullet.changeDynamics(self.id, link, lateralFriction=BODY_FRICTION, **self._call)
+        # With no friction a ball caster carries weight but never steers the robot.
+        for link in caster_links:
+            pybullet.changeDynamics(self.id, link, lateralFriction=caster_friction,
+                                    rollingFriction=0.0, spinningFriction=0.0, **self._call)
+        for link in set([-1] + list(links.values())):
+            pybullet.setCollisionFilterGroupMask(self.id, link, _int32(group), -1, **self._call)
+        self.radius = self._bounding_radius()
+        self.set_wheel_speeds(0.0, 0.0)
+
+    def _load(self, urdf_path, pose):
+        x, y, z, yaw = pose
         # pybullet loads from a file name: write the completed URDF beside the original's
         # name in a temporary folder (mesh paths, if any, would be absolute).
         with tempfile.TemporaryDirectory() as folder:
@@ -120,11 +208,21 @@ class SimWorld(object):
     def _link_indices(self):
         """Joint name -> index, and child link name -> index (they coincide in pybullet)."""
         indices = {}
-        for index in range(pybullet.getNumJoints(self.robot, **self._call)):
-            info = pybullet.getJointInfo(self.robot, index, **self._call)
+        for index in range(pybullet.getNumJoints(self.id, **self._call)):
+            info = pybullet.getJointInfo(self.id, index, **self._call)
             indices[info[1].decode()] = index
             indices[info[12].decode()] = index
         return indices
+
+    def _bounding_radius(self):
+        """Distance from base_footprint to the furthest corner of any link's bounding box."""
+        base = np.array(self.base_pose()[0])
+        corners = [corner for link in [-1] + sorted(set(self.links.values()))
+                   for corner in pybullet.getAABB(self.id, link, **self._call)]
+        return max(np.linalg.norm(np.array(corner) - base) for corner in corners)
+
+    def remove(self):
+        pybullet.removeBody(self.id, **self._call)
 
     def set_wheel_speeds(self, left, right):
         """Target angular speeds (rad/s) of the wheel motors.
@@ -135,28 +233,24 @@ class SimWorld(object):
         torques = [self.wheel_torque] * 2
         if left == 0.0 and right == 0.0:
             pybullet.setJointMotorControlArray(
-                self.robot, self.wheels, pybullet.POSITION_CONTROL,
+                self.id, self.wheels, pybullet.POSITION_CONTROL,
                 targetPositions=self.wheel_states()[0], forces=torques, **self._call)
         else:
             pybullet.setJointMotorControlArray(
-                self.robot, self.wheels, pybullet.VELOCITY_CONTROL,
+                self.id, self.wheels, pybullet.VELOCITY_CONTROL,
                 targetVelocities=[left, right], forces=torques, **self._call)
 
-    def step(self):
-        pybullet.stepSimulation(**self._call)
-
-    def reset_robot(self, pose):
+    def reset(self, pose):
         """Put the robot at `pose` (x, y, z, yaw), at rest, wheels at angle 0."""
         x, y, z, yaw = pose
-        pybullet.resetBasePositionAndOrientation(self.robot, [x, y, z], yaw_to_quaternion(yaw),
-                                                 **self._call)
-        pybullet.resetBaseVelocity(self.robot, [0, 0, 0], [0, 0, 0], **self._call)
+        pybullet.resetBasePositionAndOrientation(self.id, [x, y, z], yaw_to_quaternion(yaw), **self._call)
+        pybullet.resetBaseVelocity(self.id, [0, 0, 0], [0, 0, 0], **self._call)
         for wheel in self.wheels:
-            pybullet.resetJointState(self.robot, wheel, 0.0, 0.0, **self._call)
+            pybullet.resetJointState(self.id, wheel, 0.0, 0.0, **self._call)
 
     def base_pose(self):
         """Position (x, y, z) and orientation (x, y, z, w) of base_footprint in the world."""
-        return pybullet.getBasePositionAndOrientation(self.robot, **self._call)
+        return pybullet.getBasePositionAndOrientation(self.id, **self._call)
 
     def base_twist(self):
         """Linear and angular velocity of base_footprint, both in its own frame."""
@@ -167,46 +261,14 @@ class SimWorld(object):
 
     def base_velocity(self):
         """Linear and angular velocity of base_footprint in world axes."""
-        return pybullet.getBaseVelocity(self.robot, **self._call)
+        return pybullet.getBaseVelocity(self.id, **self._call)
 
     def link_pose(self, link):
-        """Position and orientation (x, y, z, w) of a robot link's frame in the world."""
-        state = pybullet.getLinkState(self.robot, self.links[link], **self._call)
+        """Position and orientation (x, y, z, w) of a link's frame in the world."""
+        state = pybullet.getLinkState(self.id, self.links[link], **self._call)
         return state[4], state[5]
-
-    def cast_rays(self, origin, ends):
-        """Hit fraction of each ray from `origin` (3) to `ends` (N x 3) against the
-        static bodies, inf where it hits none: the robot's links are dynamic, so
-        the robot never sees itself.
-
-        Rays that cannot reach a static body are not cast: pybullet builds
-        python tuples for every ray, which in the open costs more than the cast.
-        """
-        fractions = np.full(len(ends), math.inf)
-        cast = self._may_hit(np.asarray(origin, dtype=float), ends)
-        if cast.any():
-            starts = np.broadcast_to(origin, ends.shape)[cast]
-            hits = pybullet.rayTestBatch(starts, ends[cast], numThreads=1,
-                                         collisionFilterMask=STATIC_BODIES, **self._call)
-            fractions[cast] = [hit[2] if hit[0] >= 0 else math.inf for hit in hits]
-        return fractions
-
-    def _may_hit(self, origin, ends):
-        """Per ray, False only if it can hit no static body: with an obstacle's
-        bounding box within reach, every ray may (most then hit something);
-        without, only those that reach the ground plane (z = 0)."""
-        low, high = self._obstacle_boxes  # K x 3 each
-        gaps = np.linalg.norm(np.maximum(np.maximum(low - origin, origin - high), 0.0), axis=1)
-        reach = np.sqrt(((ends - origin) ** 2).sum(axis=1).max())
-        if origin[2] <= 0.0 or np.any(gaps <= reach):
-            return np.ones(len(ends), dtype=bool)
-        return ends[:, 2] <= 0.0
 
     def wheel_states(self):
         """Wheel angles (rad) and angular speeds (rad/s), left then right."""
-        states = pybullet.getJointStates(self.robot, self.wheels, **self._call)
+        states = pybullet.getJointStates(self.id, self.wheels, **self._call)
         return [state[0] for state in states], [state[1] for state in states]
-
-    def close(self):
-        if pybullet.isConnected(self.client):
-            pybullet.disconnect(self.client)

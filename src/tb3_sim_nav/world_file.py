@@ -1,18 +1,24 @@
-"""World files: static boxes and cylinders on the ground plane, in YAML.
+"""World files: static boxes and cylinders on the ground plane, and robots, in YAML.
 
     # worlds/example.yaml
     obstacles:
-      - box: {size: [4.0, 0.1, 0.4], position: [0.0, 2.0], yaw: 0.0}
+      - box: {size: [4.0, 0.1, 0.4], position: [0.0, 2.0], yaw: 0.0, name: north_wall}
       - cylinder: {radius: 0.15, height: 0.4, position: [1.1, 1.1]}
+    robots:
+      - {name: tb3_3, model: burger, position: [-1.0, 0.5], yaw: 1.57}
 
 Units are metres and radians. `position` is [x, y] of the shape's centre
 (or [x, y, z]; z defaults to half the height, so the shape stands on the
 ground); `yaw` (default 0) turns it about z; `color` is an optional
-[r, g, b, a] in 0..1. A world named without a path ("empty",
-"turtlebot3_world") is a file of that name in the package's worlds/ folder.
+[r, g, b, a] in 0..1; `name` is optional and unique. A robot's `position`
+is that of its base_footprint (z defaults to 0), its `name` its namespace
+and tf prefix, its `model` burger, waffle, waffle_pi or the path of a URDF.
+A world named without a path ("empty", "turtlebot3_world") is a file of
+that name in the package's worlds/ folder.
 """
 import math
 import os
+import re
 from collections import namedtuple
 
 import yaml
@@ -20,10 +26,19 @@ import yaml
 DEFAULT_COLOR = (0.75, 0.75, 0.72, 1.0)
 
 #: kind is 'box' (size = (x, y, z) edge lengths) or 'cylinder' (size = (radius, height)).
-Obstacle = namedtuple('Obstacle', 'kind size position yaw color')
+Obstacle = namedtuple('Obstacle', 'kind size position yaw color name', defaults=('',))
+
+#: A robot to spawn: `name` ('' for the tutorial's robot without a namespace),
+#: `model` (burger, waffle, waffle_pi or a URDF path), `position` (x, y, z), `yaw`.
+RobotSpec = namedtuple('RobotSpec', 'name model position yaw')
+
+#: A world: its obstacles and its robots.
+WorldSpec = namedtuple('WorldSpec', 'obstacles robots')
 
 _SHAPE_KEYS = {'box': {'size'}, 'cylinder': {'radius', 'height'}}
-_OPTIONAL_KEYS = {'position', 'yaw', 'color'}
+_OPTIONAL_KEYS = {'position', 'yaw', 'color', 'name'}
+_ROBOT_KEYS = {'name', 'model', 'position', 'yaw'}
+_NAME = re.compile(r'[A-Za-z][A-Za-z0-9_]*$')  # a ROS graph name without slashes
 
 
 class WorldError(ValueError):
@@ -80,11 +95,57 @@ def _obstacle(entry):
         position += (height / 2.0,)
     (yaw,) = _numbers('yaw', [fields.get('yaw', 0.0)], (1,))
     color = _numbers('color', fields.get('color', DEFAULT_COLOR), (4,))
-    return Obstacle(kind, size, position, yaw, color)
+    name = fields.get('name', '')
+    if not isinstance(name, str):
+        raise ValueError('name must be a string, not %r' % (name,))
+    return Obstacle(kind, size, position, yaw, color, name)
+
+
+def _robot(entry):
+    if not isinstance(entry, dict):
+        raise ValueError('must be a mapping of name, model, position and yaw, not %r' % (entry,))
+    missing = {'name', 'model', 'position'} - set(entry)
+    unknown = set(entry) - _ROBOT_KEYS
+    if missing or unknown:
+        raise ValueError('missing %s, unknown %s' % (sorted(missing) or 'nothing', sorted(unknown) or 'nothing'))
+    name, model = entry['name'], entry['model']
+    if not isinstance(name, str) or not _NAME.match(name):
+        raise ValueError('name %r must be a ROS name: a letter, then letters, digits or _' % (name,))
+    if not isinstance(model, str) or not model:
+        raise ValueError('robot %s: model must be burger, waffle, waffle_pi or a URDF path, not %r'
+                         % (name, model))
+    position = _numbers('robot %s: position' % name, entry['position'], (2, 3))
+    (yaw,) = _numbers('robot %s: yaw' % name, [entry.get('yaw', 0.0)], (1,))
+    return RobotSpec(name, model, position + (0.0,) * (3 - len(position)), yaw)
+
+
+def _parse_list(entries, parse, what, where):
+    """[parse(entry) for each entry] of a YAML list, each name used once, or
+    WorldError naming `where`, the entry's number and the problem."""
+    if entries is None:  # "robots:" with nothing after it
+        entries = []
+    if not isinstance(entries, (list, tuple)):
+        raise WorldError('%s: "%ss" must be a list, not %r' % (where, what, entries))
+    items = []
+    for index, entry in enumerate(entries):
+        try:
+            items.append(parse(entry))
+        except ValueError as error:
+            raise WorldError('%s, %s %d: %s' % (where, what, index + 1, error))
+    names = [item.name for item in items if item.name]
+    for name in names:
+        if names.count(name) > 1:
+            raise WorldError('%s: two %ss are named %r' % (where, what, name))
+    return items
+
+
+def parse_robots(entries, where='~robots'):
+    """RobotSpecs of a list of robot mappings, or WorldError saying which entry is wrong."""
+    return _parse_list(entries, _robot, 'robot', where)
 
 
 def load_world(world, worlds_folder):
-    """The obstacles of a world given by name or path, or WorldError."""
+    """The WorldSpec of a world given by name or path, or WorldError."""
     path = world_path(world, worlds_folder)
     if not os.path.isfile(path):
         raise WorldError('world %r: file %s does not exist' % (world, path))
@@ -95,19 +156,10 @@ def load_world(world, worlds_folder):
         raise WorldError('world file %s is not valid YAML: %s' % (path, error))
     if document is None:
         document = {}
-    if not isinstance(document, dict) or set(document) - {'obstacles'}:
-        raise WorldError('world file %s: the top level must be a mapping with the one key '
-                         '"obstacles", not %r' % (path, sorted(document) if isinstance(document, dict)
-                                                  else document))
-    entries = document.get('obstacles', [])
-    if entries is None:  # "obstacles:" with nothing after it
-        entries = []
-    if not isinstance(entries, list):
-        raise WorldError('world file %s: "obstacles" must be a list' % path)
-    obstacles = []
-    for index, entry in enumerate(entries):
-        try:
-            obstacles.append(_obstacle(entry))
-        except ValueError as error:
-            raise WorldError('world file %s, obstacle %d: %s' % (path, index + 1, error))
-    return obstacles
+    if not isinstance(document, dict) or set(document) - {'obstacles', 'robots'}:
+        raise WorldError('world file %s: the top level must be a mapping with the keys '
+                         '"obstacles" and "robots", not %r' % (path, sorted(document) if isinstance(document, dict)
+                                                              else document))
+    where = 'world file %s' % path
+    return WorldSpec(_parse_list(document.get('obstacles'), _obstacle, 'obstacle', where),
+                     _parse_list(document.get('robots'), _robot, 'robot', where))

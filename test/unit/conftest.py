@@ -29,18 +29,21 @@ def worlds_folder():
 
 @pytest.fixture
 def world_factory(burger_urdf):
-    """make(time_step, settle, spawn_pose, obstacles): a SimWorld left to
-    settle for `settle` s of sim time; every one is closed after the test."""
-    from tb3_sim_nav.world import SimWorld
+    """make(time_step, settle, spawn_pose, obstacles): the RobotBody of a Burger in
+    a World (its `world`) left to settle for `settle` s of sim time; every world
+    is closed after the test."""
+    from tb3_sim_nav.robot_model import load_model
+    from tb3_sim_nav.world import World
+    model = load_model(str(burger_urdf))
     worlds = []
 
     def make(time_step, settle, spawn_pose=(0.0, 0.0, 0.0, 0.0), obstacles=()):
-        world = SimWorld(str(burger_urdf), spawn_pose=spawn_pose, time_step=time_step,
-                         obstacles=obstacles)
+        world = World(time_step, obstacles)
         worlds.append(world)
+        robot = world.add_robot(model.urdf_file, spawn_pose, casters=model.casters)
         for _ in range(int(round(settle / time_step))):
             world.step()
-        return world
+        return robot
     yield make
     for world in worlds:
         world.close()

@@ -1,4 +1,4 @@
-"""ros_node._local_pid: which cmd_vel publishers lockstep can wait for. No
+"""lockstep.local_pid: which cmd_vel publishers lockstep can wait for. No
 master: a bare XML-RPC server on loopback stands in for a node's API."""
 import os
 import socket
@@ -7,7 +7,7 @@ from xmlrpc.server import SimpleXMLRPCServer
 
 import pytest
 
-from tb3_sim_nav.ros_node import _local_pid
+from tb3_sim_nav.ros.lockstep import local_pid as _local_pid
 
 
 class Connection(object):

@@ -1,9 +1,10 @@
 """Parameter validation: defaults, types and ranges, with messages naming name and value."""
+import dataclasses
 import math
 
 import pytest
 
-from tb3_sim_nav.params import PROFILES, PARAMETERS, ParameterError, resolve
+from tb3_sim_nav.params import FROM_MODEL, FROM_PROFILE, PROFILES, PARAMETERS, ParameterError, resolve
 
 
 @pytest.fixture
@@ -18,25 +19,29 @@ def resolve_with(burger_urdf):
 
 def test_defaults_resolve(resolve_with, burger_urdf):
     config = resolve_with()
-    assert list(config) == [parameter.name for parameter in PARAMETERS]
+    assert [field.name for field in dataclasses.fields(config)] == [parameter.name for parameter in PARAMETERS]
     for parameter in PARAMETERS:
+        value = getattr(config, parameter.name)
+        if parameter.origin == FROM_MODEL:  # the robot model's own (its URDF's drive_limits)
+            assert value is None
+            continue
         if parameter.name == 'urdf_file':
             expected = str(burger_urdf)
-        elif parameter.default is None:  # a realism knob: the gazebo profile's default
+        elif parameter.origin == FROM_PROFILE:  # a realism knob: the gazebo profile's default
             expected = PROFILES['gazebo'][parameter.name]
         else:
             expected = parameter.default
-        assert config[parameter.name] == expected
-        assert type(config[parameter.name]) is parameter.kind
-    assert config['real_time_factor'] == 1.0 and config['physics_rate'] == 100.0
-    assert config['odom_frame'] == 'odom' and config['base_frame'] == 'base_footprint'
+        assert value == expected
+        assert type(value) is parameter.kind
+    assert config.real_time_factor == 1.0 and config.physics_rate == 100.0
+    assert config.odom_frame == 'odom' and config.base_frame == 'base_footprint'
 
 
 def test_ints_are_accepted_for_floats(resolve_with):
     config = resolve_with(physics_rate=100, imu_rate=100, odom_rate=30, x_pos=-2, real_time_factor=0)
-    assert config['physics_rate'] == 100.0 and type(config['physics_rate']) is float
-    assert config['x_pos'] == -2.0 and type(config['x_pos']) is float
-    assert config['real_time_factor'] == 0.0 and type(config['real_time_factor']) is float
+    assert config.physics_rate == 100.0 and type(config.physics_rate) is float
+    assert config.x_pos == -2.0 and type(config.x_pos) is float
+    assert config.real_time_factor == 0.0 and type(config.real_time_factor) is float
 
 
 @pytest.mark.parametrize('name, value, shown', [
@@ -86,7 +91,7 @@ def test_odom_rate_above_physics_rate_names_both(resolve_with):
 
 
 def test_odom_rate_equal_to_physics_rate_is_fine(resolve_with):
-    assert resolve_with(physics_rate=100.0, imu_rate=100.0, odom_rate=100.0)['odom_rate'] == 100.0
+    assert resolve_with(physics_rate=100.0, imu_rate=100.0, odom_rate=100.0).odom_rate == 100.0
 
 
 def test_a_sensor_rate_above_the_physics_rate_is_refused(resolve_with):
@@ -97,13 +102,13 @@ def test_a_sensor_rate_above_the_physics_rate_is_refused(resolve_with):
 def test_the_realistic_profile_sets_its_knobs(resolve_with):
     config = resolve_with(profile='realistic')
     for name, value in PROFILES['realistic'].items():
-        assert config[name] == value
-    assert config['odom_source'] == 'encoders' and config['cmd_vel_timeout'] == 0.5
+        assert getattr(config, name) == value
+    assert config.odom_source == 'encoders' and config.cmd_vel_timeout == 0.5
 
 
 def test_an_explicit_knob_beats_the_profile(resolve_with):
     config = resolve_with(profile='realistic', cmd_vel_timeout=0.0, odom_source='world')
-    assert config['cmd_vel_timeout'] == 0.0 and config['odom_source'] == 'world'
+    assert config.cmd_vel_timeout == 0.0 and config.odom_source == 'world'
 
 
 @pytest.mark.parametrize('name, value', [('profile', 'gazebo_classic'), ('odom_source', 'gps'),

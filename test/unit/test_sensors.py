@@ -34,18 +34,18 @@ ROOM = [box(SCAN_X + FRONT + WALL / 2, 0.0, WALL, 6.0),
 
 @pytest.fixture
 def make_world(world_factory):
-    """make_world(obstacles): a world settled for 0.5 s; closed after the test."""
+    """make_world(obstacles): a robot in a world settled for 0.5 s; closed after the test."""
     return lambda obstacles=(): world_factory(STEP, 0.5, obstacles=obstacles)
 
 
-def run(world, seconds):
+def run(robot, seconds):
     for _ in range(int(round(seconds / STEP))):
-        world.step()
+        robot.world.step()
 
 
-def expected_room_ranges(world, samples):
+def expected_room_ranges(robot, samples):
     """Per beam, the distance from the actual scan origin to the room's wall it points at."""
-    (ox, oy, _oz), (qx, qy, qz, qw) = world.link_pose('base_scan')
+    (ox, oy, _oz), (qx, qy, qz, qw) = robot.link_pose('base_scan')
     yaw = math.atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
     front, back = SCAN_X + FRONT, SCAN_X - BACK
     ranges = []
@@ -68,22 +68,22 @@ def expected_room_ranges(world, samples):
 # --- lidar ---------------------------------------------------------------------------
 
 def test_four_beams_read_front_left_back_right_counter_clockwise(make_world):
-    world = make_world(ROOM)
-    ranges = Lidar(world, 'base_scan', samples=4, noise_stddev=0.0).scan()
+    robot = make_world(ROOM)
+    ranges = Lidar(robot, 'base_scan', samples=4, noise_stddev=0.0).scan()
     assert ranges == pytest.approx([FRONT, LEFT, BACK, RIGHT], abs=0.001)
 
 
 def test_noiseless_room_scan_is_exact_to_1_mm_at_every_angle(make_world):
-    world = make_world(ROOM)
-    ranges = Lidar(world, 'base_scan', noise_stddev=0.0).scan()
+    robot = make_world(ROOM)
+    ranges = Lidar(robot, 'base_scan', noise_stddev=0.0).scan()
     assert len(ranges) == 360
-    assert np.abs(ranges - expected_room_ranges(world, 360)).max() < 0.001
+    assert np.abs(ranges - expected_room_ranges(robot, 360)).max() < 0.001
 
 
 def test_noisy_room_scan_is_true_range_plus_sigma_noise(make_world):
-    world = make_world(ROOM)
-    lidar = Lidar(world, 'base_scan', noise_stddev=SIGMA, rng=np.random.default_rng(11))
-    errors = lidar.scan() - expected_room_ranges(world, 360)
+    robot = make_world(ROOM)
+    lidar = Lidar(robot, 'base_scan', noise_stddev=SIGMA, rng=np.random.default_rng(11))
+    errors = lidar.scan() - expected_room_ranges(robot, 360)
     # 360 Gaussian draws: about one beyond 3 sigma is expected, none beyond 5 sigma.
     assert np.abs(errors).max() < 5 * SIGMA
     assert np.mean(np.abs(errors) < 3 * SIGMA) >= 0.99
@@ -92,15 +92,15 @@ def test_noisy_room_scan_is_true_range_plus_sigma_noise(make_world):
 
 
 def test_beam_with_nothing_within_range_max_reads_plus_inf(make_world):
-    world = make_world([box(SCAN_X + 3.6 + WALL / 2, 0.0, WALL, 1.0)])  # 3.6 m ahead
-    assert Lidar(world, 'base_scan', range_max=3.5, noise_stddev=0.0).scan()[0] == math.inf
-    assert Lidar(world, 'base_scan', range_max=4.0, noise_stddev=0.0).scan()[0] == \
+    robot = make_world([box(SCAN_X + 3.6 + WALL / 2, 0.0, WALL, 1.0)])  # 3.6 m ahead
+    assert Lidar(robot, 'base_scan', range_max=3.5, noise_stddev=0.0).scan()[0] == math.inf
+    assert Lidar(robot, 'base_scan', range_max=4.0, noise_stddev=0.0).scan()[0] == \
         pytest.approx(3.6, abs=0.001)
 
 
 def test_beams_pointing_away_from_a_single_wall_read_plus_inf(make_world):
-    world = make_world([box(SCAN_X + FRONT + WALL / 2, 0.0, WALL, 20.0)])
-    ranges = Lidar(world, 'base_scan', samples=360, noise_stddev=SIGMA).scan()
+    robot = make_world([box(SCAN_X + FRONT + WALL / 2, 0.0, WALL, 20.0)])
+    ranges = Lidar(robot, 'base_scan', samples=360, noise_stddev=SIGMA).scan()
     angles = np.arange(360) * 2 * math.pi / 360
     # the wall's face along each beam: FRONT / cos(angle), when the beam points at it
     cosines = np.cos(angles)
@@ -113,85 +113,85 @@ def test_beams_pointing_away_from_a_single_wall_read_plus_inf(make_world):
 
 def test_pillar_closer_than_range_min_reads_minus_inf(make_world):
     # 0.1 m behind the scan origin: clear of the base (it ends 0.07 m behind), within 0.12 m.
-    world = make_world([pillar(SCAN_X - 0.10 - 0.01, 0.0)])
+    robot = make_world([pillar(SCAN_X - 0.10 - 0.01, 0.0)])
     # Without noise: with the LDS's 1 cm, a 0.10 m hit reads past 0.12 m one
     # scan in 40, as a real one would (the limit applies to what is measured).
-    near = Lidar(world, 'base_scan', range_min=0.12, noise_stddev=0.0).scan()
+    near = Lidar(robot, 'base_scan', range_min=0.12, noise_stddev=0.0).scan()
     assert near[180] == -math.inf
     # ...and it is a real hit at 0.10 m, not the robot itself:
-    assert Lidar(world, 'base_scan', range_min=0.0, noise_stddev=0.0).scan()[180] == \
+    assert Lidar(robot, 'base_scan', range_min=0.0, noise_stddev=0.0).scan()[180] == \
         pytest.approx(0.10, abs=0.001)
     assert np.all(near[:90] == math.inf)
 
 
 def test_robot_never_sees_itself(make_world):
-    world = make_world()
+    robot = make_world()
     for range_min in (0.0, 0.12):
-        ranges = Lidar(world, 'base_scan', range_min=range_min, noise_stddev=SIGMA).scan()
+        ranges = Lidar(robot, 'base_scan', range_min=range_min, noise_stddev=SIGMA).scan()
         assert np.all(ranges == math.inf)
 
 
 @pytest.mark.parametrize('samples', [3, 90, 360, 720])
 def test_beam_count_and_increment_follow_samples(make_world, samples):
-    world = make_world(ROOM)
-    lidar = Lidar(world, 'base_scan', samples=samples, noise_stddev=0.0)
+    robot = make_world(ROOM)
+    lidar = Lidar(robot, 'base_scan', samples=samples, noise_stddev=0.0)
     assert lidar.angle_increment == pytest.approx(2 * math.pi / samples)
     ranges = lidar.scan()
     assert ranges.shape == (samples,)
-    assert np.abs(ranges - expected_room_ranges(world, samples)).max() < 0.001
+    assert np.abs(ranges - expected_room_ranges(robot, samples)).max() < 0.001
 
 
 def test_seeded_lidars_give_identical_noisy_scans(make_world):
-    world = make_world(ROOM)
-    first = Lidar(world, 'base_scan', rng=np.random.default_rng(7)).scan()
-    second = Lidar(world, 'base_scan', rng=np.random.default_rng(7)).scan()
-    other = Lidar(world, 'base_scan', rng=np.random.default_rng(8)).scan()
+    robot = make_world(ROOM)
+    first = Lidar(robot, 'base_scan', rng=np.random.default_rng(7)).scan()
+    second = Lidar(robot, 'base_scan', rng=np.random.default_rng(7)).scan()
+    other = Lidar(robot, 'base_scan', rng=np.random.default_rng(8)).scan()
     assert np.array_equal(first, second)
     assert not np.array_equal(first, other)
 
 
 # --- IMU -----------------------------------------------------------------------------
 
-def readings(world, imu, seconds, start=0.0):
+def readings(robot, imu, seconds, start=0.0):
     result = []
     for step in range(int(round(seconds / STEP))):
-        world.step()
+        robot.world.step()
         result.append(imu.read(start + (step + 1) * STEP))
     return result
 
 
 def test_imu_at_rest_reads_gravity_up_and_no_rotation(make_world):
-    world = make_world()
-    for reading in readings(world, Imu(world), 0.5):
+    robot = make_world()
+    for reading in readings(robot, Imu(robot), 0.5):
         assert reading.linear_acceleration == pytest.approx((0.0, 0.0, 9.81), abs=0.05)
         assert reading.angular_velocity == pytest.approx((0.0, 0.0, 0.0), abs=1e-3)
 
 
 def test_imu_orientation_is_the_base_orientation(make_world, burger_urdf):
-    world = make_world()
-    world.set_wheel_speeds(*wheel_speeds(0.1, 0.8, *read_drive_geometry(str(burger_urdf))))
-    imu = Imu(world)
-    run(world, 1.0)
+    robot = make_world()
+    robot.set_wheel_speeds(*wheel_speeds(0.1, 0.8, *read_drive_geometry(str(burger_urdf))))
+    imu = Imu(robot)
+    run(robot, 1.0)
     reading = imu.read(1.0)
-    orientation = world.base_pose()[1]
+    orientation = robot.base_pose()[1]
     assert abs(orientation[2]) > 0.3  # it has turned
     assert reading.orientation == pytest.approx(orientation, abs=1e-9)
 
 
 def test_imu_reads_yaw_rate_turning_in_place(make_world, burger_urdf):
-    world = make_world()
-    world.set_wheel_speeds(*wheel_speeds(0.0, 1.0, *read_drive_geometry(str(burger_urdf))))
-    imu = Imu(world)
-    late = readings(world, imu, 1.5)[-50:]  # past the spin-up
+    robot = make_world()
+    robot.set_wheel_speeds(*wheel_speeds(0.0, 1.0, *read_drive_geometry(str(burger_urdf))))
+    imu = Imu(robot)
+    late = readings(robot, imu, 1.5)[-50:]  # past the spin-up
     for reading in late:
         assert reading.angular_velocity[2] == pytest.approx(1.0, rel=0.05)
         assert reading.angular_velocity[:2] == pytest.approx((0.0, 0.0), abs=0.01)
 
 
 def test_imu_noise_has_the_requested_standard_deviation(make_world):
-    world = make_world()
-    imu = Imu(world, gyro_noise=0.02, accel_noise=0.1, rng=np.random.default_rng(5))
-    got = readings(world, imu, 2000 * STEP)
+    robot = make_world()
+    imu = Imu(robot, gyro_noise=0.02, accel_noise=0.1, rng=np.random.default_rng(5))
+    got = readings(robot, imu, 2000 * STEP)
     rates = np.array([reading.angular_velocity for reading in got])
     forces = np.array([reading.linear_acceleration for reading in got])
     assert np.std(rates, axis=0) == pytest.approx([0.02] * 3, rel=0.15)
@@ -200,29 +200,29 @@ def test_imu_noise_has_the_requested_standard_deviation(make_world):
 
 
 def test_imu_without_noise_parameters_is_noiseless(make_world):
-    world = make_world()
-    got = readings(world, Imu(world), 0.5)
+    robot = make_world()
+    got = readings(robot, Imu(robot), 0.5)
     rates = np.array([reading.angular_velocity for reading in got])
     assert np.std(rates, axis=0).max() < 1e-5
 
 
 # --- ray casting ---------------------------------------------------------------------
 
-def every_ray_cast(world, origin, ends):
+def every_ray_cast(robot, origin, ends):
     """What cast_rays must give: pybullet's own answer for every ray, uncut."""
     import pybullet
     from tb3_sim_nav.world import STATIC_BODIES
     hits = pybullet.rayTestBatch(np.broadcast_to(origin, ends.shape), ends, numThreads=1,
-                                 collisionFilterMask=STATIC_BODIES, physicsClientId=world.client)
+                                 collisionFilterMask=STATIC_BODIES, physicsClientId=robot.world.client)
     return np.array([hit[2] if hit[0] >= 0 else math.inf for hit in hits])
 
 
 @pytest.mark.parametrize('seed', range(5))
 def test_rays_left_uncast_are_exactly_those_that_hit_nothing(world_factory, worlds_folder, seed):
     from tb3_sim_nav.world_file import load_world
-    # Where tb3_world.launch spawns it, beside a pillar of the world's own.
-    world = world_factory(STEP, 0.0, (-2.0, -0.5, 0.0, 0.0),
-                          load_world('turtlebot3_world', str(worlds_folder)) + [pillar(-1.7, -0.5)])
+    # Where tb3_world.launch spawns it, beside a pillar of the robot's own.
+    robot = world_factory(STEP, 0.0, (-2.0, -0.5, 0.0, 0.0),
+                          load_world('turtlebot3_world', str(worlds_folder)).obstacles + [pillar(-1.7, -0.5)])
     rng = np.random.default_rng(seed)
     hits = 0
     for _ in range(20):
@@ -232,15 +232,15 @@ def test_rays_left_uncast_are_exactly_those_that_hit_nothing(world_factory, worl
         directions = rng.normal(size=(100, 3)) * (1.0, 1.0, rng.uniform(0.0, 0.3))
         directions[:10, 1:] = 0.0
         ends = origin + directions / np.linalg.norm(directions, axis=1)[:, None] * rng.uniform(0.1, 4.0, (100, 1))
-        expected = every_ray_cast(world, origin, ends)
+        expected = every_ray_cast(robot, origin, ends)
         hits += np.isfinite(expected).sum()
-        np.testing.assert_array_equal(world.cast_rays(origin, ends), expected)
+        np.testing.assert_array_equal(robot.world.cast_rays(origin, ends, ignore=robot), expected)
     assert hits > 100
 
 
 def test_rays_in_an_empty_world_above_ground_are_not_cast(make_world, monkeypatch):
     import pybullet
-    world = make_world()
+    robot = make_world()
     monkeypatch.setattr(pybullet, 'rayTestBatch', lambda *args, **kwargs: pytest.fail('cast'))
     ends = np.array([[3.0, 0.0, 0.2], [0.0, -3.0, 0.01]])
-    assert np.all(world.cast_rays((0.0, 0.0, 0.2), ends) == math.inf)
+    assert np.all(robot.world.cast_rays((0.0, 0.0, 0.2), ends, ignore=robot) == math.inf)

@@ -6,8 +6,8 @@ import pytest
 
 from tb3_sim_nav.diff_drive import quaternion_to_yaw, wheel_speeds
 from tb3_sim_nav.params import PARAMETERS, resolve
-from tb3_sim_nav.robot_model import read_drive_geometry
-from tb3_sim_nav.simulation import Simulation
+from tb3_sim_nav.robot_model import load_model, read_drive_geometry
+from tb3_sim_nav.simulation import build
 from tb3_sim_nav.world_file import load_world
 
 RATE = 100  # physics_rate default
@@ -15,20 +15,62 @@ COMMAND_EVERY = 20  # steps: `rostopic pub -r 10`
 ODOM_EVERY = 7      # steps: odom at ~30 Hz, as the node reads it
 
 
+class OneRobot(object):
+    """A Simulation with the one robot of the tutorial's launch, read as the node reads it."""
+
+    def __init__(self, simulation):
+        self.simulation = simulation
+        self.robot = simulation.robots['']
+        self.config = simulation.config
+
+    steps = property(lambda self: self.simulation.steps)
+    now_ns = property(lambda self: self.simulation.now_ns)
+
+    def command(self, v, w):
+        self.robot.command(v, w, self.simulation.now_ns)
+
+    def step(self):
+        self.simulation.step()
+
+    def reset_world(self):
+        self.simulation.reset_world()
+
+    def reset_simulation(self):
+        self.simulation.reset_simulation()
+
+    def true_pose(self):
+        return self.robot.truth()[0]
+
+    def true_twist(self):
+        return self.robot.truth()[1]
+
+    def odometry(self, truth):
+        return self.robot.odometry(truth)
+
+    def odometry_pose(self):
+        return self.robot.odometry()[0]
+
+    def odometry_twist(self):
+        return self.robot.odometry()[1]
+
+    def wheel_states(self):
+        return self.robot.wheel_states()
+
+
 @pytest.fixture
 def make_sim(burger_urdf):
-    """make_sim(obstacles=(), **parameters): a Simulation, closed after the test."""
+    """make_sim(obstacles=(), **parameters): a OneRobot, closed after the test."""
     sims = []
-    geometry = read_drive_geometry(str(burger_urdf))
+    model = load_model(str(burger_urdf))
 
     def make(obstacles=(), **overrides):
         # resolve() ignores names it does not know: a renamed parameter must fail here.
         assert set(overrides) <= {parameter.name for parameter in PARAMETERS}, overrides
         overrides.setdefault('urdf_file', str(burger_urdf))
         config = resolve(lambda name, default: overrides.get(name, default))
-        sim = Simulation(config, geometry, obstacles)
+        sim = build(config, obstacles, [('', model, (config.x_pos, config.y_pos, config.z_pos, config.yaw))])
         sims.append(sim)
-        return sim
+        return OneRobot(sim)
     yield make
     for sim in sims:
         sim.close()
@@ -74,7 +116,7 @@ def test_straight_command_for_5_s_drives_1_m(make_sim):
     sim.command(0.2, 0.0)  # once: the default profile holds it
     run(sim, 5.0)
     x, y, yaw = pose(sim.true_pose())
-    ramp_loss = 0.2 ** 2 / (2 * sim.config['wheel_acceleration'])  # 2 cm at 1 m/s^2
+    ramp_loss = 0.2 ** 2 / (2 * sim.config.wheel_acceleration)  # 2 cm at 1 m/s^2
     assert x == pytest.approx(1.0 - ramp_loss, abs=0.005)
     assert abs(y) < 0.005 and angle_between(yaw, 0.0) < math.radians(1.0)
 
@@ -208,13 +250,13 @@ def test_reset_simulation_also_sets_time_to_zero(make_sim):
 # --- spawning ------------------------------------------------------------------------
 
 def test_spawning_inside_an_obstacle_names_it(make_sim, worlds_folder):
-    obstacles = load_world('turtlebot3_world', str(worlds_folder))
+    obstacles = load_world('turtlebot3_world', str(worlds_folder)).obstacles
     with pytest.raises(ValueError, match='obstacle 11'):  # the centre pillar
         make_sim(obstacles, x_pos=0.0, y_pos=0.0)
 
 
 def test_the_launch_spawn_pose_in_turtlebot3_world_is_clear(make_sim, worlds_folder):
-    sim = make_sim(load_world('turtlebot3_world', str(worlds_folder)), x_pos=-2.0, y_pos=-0.5)
+    sim = make_sim(load_world('turtlebot3_world', str(worlds_folder)).obstacles, x_pos=-2.0, y_pos=-0.5)
     assert pose(sim.true_pose())[:2] == pytest.approx((-2.0, -0.5))
 
 
@@ -223,7 +265,7 @@ def connected_clients():
 
 
 def test_a_refused_spawn_leaves_no_pybullet_client_open(make_sim, worlds_folder):
-    obstacles = load_world('turtlebot3_world', str(worlds_folder))
+    obstacles = load_world('turtlebot3_world', str(worlds_folder)).obstacles
     before = connected_clients()
     with pytest.raises(ValueError):
         make_sim(obstacles, x_pos=0.0, y_pos=0.0)

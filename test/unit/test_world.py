@@ -19,22 +19,22 @@ def geometry(burger_urdf):
 
 @pytest.fixture
 def make_world(world_factory):
-    """make_world(x, y, yaw): a settled world at that spawn pose; closed after the test."""
+    """make_world(x, y, yaw): a robot settled in a world at that spawn pose; closed after the test."""
     return lambda x=0.0, y=0.0, yaw=0.0: world_factory(STEP, SETTLE_STEPS * STEP, (x, y, 0.0, yaw))
 
 
-def run(world, seconds):
+def run(robot, seconds):
     for _ in range(int(round(seconds / STEP))):
-        world.step()
+        robot.world.step()
 
 
-def drive(world, geometry, v, w):
-    world.set_wheel_speeds(*wheel_speeds(v, w, *geometry))
+def drive(robot, geometry, v, w):
+    robot.set_wheel_speeds(*wheel_speeds(v, w, *geometry))
 
 
-def pose(world):
+def pose(robot):
     """(x, y, z, roll, pitch, yaw) of base_footprint."""
-    position, orientation = world.base_pose()
+    position, orientation = robot.base_pose()
     roll, pitch, _ = pybullet.getEulerFromQuaternion(orientation)
     return tuple(position) + (roll, pitch, quaternion_to_yaw(*orientation))
 
@@ -43,63 +43,63 @@ def angle_between(a, b):
     return abs(math.remainder(a - b, 2 * math.pi))
 
 
-def link_index(world, name):
-    for index in range(pybullet.getNumJoints(world.robot, physicsClientId=world.client)):
-        info = pybullet.getJointInfo(world.robot, index, physicsClientId=world.client)
+def link_index(robot, name):
+    for index in range(pybullet.getNumJoints(robot.id, physicsClientId=robot.world.client)):
+        info = pybullet.getJointInfo(robot.id, index, physicsClientId=robot.world.client)
         if info[12].decode() == name:
             return index
     raise KeyError(name)
 
 
 def test_robot_settles_level_on_wheels_and_caster(make_world):
-    world = make_world()
-    x, y, z, roll, pitch, _yaw = pose(world)
+    robot = make_world()
+    x, y, z, roll, pitch, _yaw = pose(robot)
     assert abs(z) < 0.002
     assert abs(math.degrees(roll)) < 1.0 and abs(math.degrees(pitch)) < 1.0
-    contacts = pybullet.getContactPoints(world.robot, world.plane, physicsClientId=world.client)
+    contacts = pybullet.getContactPoints(robot.id, robot.world.plane, physicsClientId=robot.world.client)
     touching = {contact[3] for contact in contacts}
-    expected = {link_index(world, 'wheel_left_link'), link_index(world, 'wheel_right_link'),
-                link_index(world, 'caster_back_link')}
+    expected = {link_index(robot, 'wheel_left_link'), link_index(robot, 'wheel_right_link'),
+                link_index(robot, 'caster_back_link')}
     assert touching == expected
 
 
 def test_robot_at_rest_stays_put_for_10_s(make_world):
-    world = make_world()
-    before = pose(world)
-    run(world, 10.0)
-    after = pose(world)
+    robot = make_world()
+    before = pose(robot)
+    run(robot, 10.0)
+    after = pose(robot)
     assert math.dist(before[:3], after[:3]) < 0.001
     assert angle_between(before[5], after[5]) < math.radians(0.1)
 
 
 def test_straight_drive_covers_one_metre(make_world, geometry):
-    world = make_world()
-    drive(world, geometry, 0.2, 0.0)
-    run(world, 5.0)
-    x, y, _z, _roll, _pitch, yaw = pose(world)
+    robot = make_world()
+    drive(robot, geometry, 0.2, 0.0)
+    run(robot, 5.0)
+    x, y, _z, _roll, _pitch, yaw = pose(robot)
     assert x == pytest.approx(1.0, rel=0.02)
     assert abs(y) < 0.005
     assert angle_between(yaw, 0.0) < math.radians(1.0)
 
 
 def test_in_place_turn_of_pi_seconds_at_1_rad_s_turns_180_deg(make_world, geometry):
-    world = make_world()
-    drive(world, geometry, 0.0, 1.0)
-    run(world, math.pi)
-    drive(world, geometry, 0.0, 0.0)
-    run(world, 0.5)
-    x, y, _z, _roll, _pitch, yaw = pose(world)
+    robot = make_world()
+    drive(robot, geometry, 0.0, 1.0)
+    run(robot, math.pi)
+    drive(robot, geometry, 0.0, 0.0)
+    run(robot, 0.5)
+    x, y, _z, _roll, _pitch, yaw = pose(robot)
     assert math.degrees(angle_between(yaw, math.pi)) < 2.0
     assert math.hypot(x, y) < 0.005
 
 
 def test_circle_has_radius_v_over_w_and_turns_clockwise(make_world, geometry):
-    world = make_world()
-    drive(world, geometry, 0.1, -0.5)
+    robot = make_world()
+    drive(robot, geometry, 0.1, -0.5)
     points, turned, last_yaw = [], 0.0, 0.0
     for _ in range(int(round(4 * math.pi / STEP))):  # one full circle
-        world.step()
-        x, y, _z, _roll, _pitch, yaw = pose(world)
+        robot.world.step()
+        x, y, _z, _roll, _pitch, yaw = pose(robot)
         points.append((x, y))
         turned += math.remainder(yaw - last_yaw, 2 * math.pi)
         last_yaw = yaw
@@ -114,41 +114,41 @@ def test_circle_has_radius_v_over_w_and_turns_clockwise(make_world, geometry):
 
 
 def test_base_twist_is_in_body_frame_whatever_the_heading(make_world, geometry):
-    world = make_world(yaw=math.pi / 2)
-    drive(world, geometry, 0.2, 0.0)
-    run(world, 2.0)
-    linear, angular = world.base_twist()
+    robot = make_world(yaw=math.pi / 2)
+    drive(robot, geometry, 0.2, 0.0)
+    run(robot, 2.0)
+    linear, angular = robot.base_twist()
     assert linear == pytest.approx((0.2, 0.0, 0.0), abs=0.005)
     assert angular == pytest.approx((0.0, 0.0, 0.0), abs=0.01)
     # ...while in the world frame the robot heads along +y.
-    x, y, *_ = pose(world)
+    x, y, *_ = pose(robot)
     assert abs(x) < 0.005 and y > 0.3
 
 
 def test_base_twist_reports_yaw_rate_while_turning(make_world, geometry):
-    world = make_world(yaw=-2.0)
-    drive(world, geometry, 0.1, -0.5)
-    run(world, 2.0)
-    linear, angular = world.base_twist()
+    robot = make_world(yaw=-2.0)
+    drive(robot, geometry, 0.1, -0.5)
+    run(robot, 2.0)
+    linear, angular = robot.base_twist()
     assert linear == pytest.approx((0.1, 0.0, 0.0), abs=0.005)
     assert angular[2] == pytest.approx(-0.5, abs=0.02)
 
 
 @pytest.mark.parametrize('x, y, yaw', [(0.0, 0.0, 0.0), (1.5, -2.0, 2.5), (-3.0, 0.7, -math.pi / 2)])
 def test_spawn_pose_is_honoured(make_world, x, y, yaw):
-    world = make_world(x, y, yaw)
-    got_x, got_y, _z, _roll, _pitch, got_yaw = pose(world)
+    robot = make_world(x, y, yaw)
+    got_x, got_y, _z, _roll, _pitch, got_yaw = pose(robot)
     assert (got_x, got_y) == pytest.approx((x, y), abs=0.001)
     assert angle_between(got_yaw, yaw) < math.radians(0.5)
 
 
 def test_wheel_angles_grow_at_v_over_r(make_world, geometry):
-    world = make_world()
-    drive(world, geometry, 0.2, 0.0)
-    run(world, 1.0)  # past the spin-up
-    angles_before, _ = world.wheel_states()
-    run(world, 2.0)
-    angles_after, speeds = world.wheel_states()
+    robot = make_world()
+    drive(robot, geometry, 0.2, 0.0)
+    run(robot, 1.0)  # past the spin-up
+    angles_before, _ = robot.wheel_states()
+    run(robot, 2.0)
+    angles_after, speeds = robot.wheel_states()
     expected = 0.2 / geometry.wheel_radius
     for before, after in zip(angles_before, angles_after):
         assert (after - before) / 2.0 == pytest.approx(expected, rel=0.02)
@@ -156,9 +156,9 @@ def test_wheel_angles_grow_at_v_over_r(make_world, geometry):
 
 
 def test_wheel_speeds_have_opposite_signs_turning_in_place(make_world, geometry):
-    world = make_world()
-    drive(world, geometry, 0.0, 1.0)
-    run(world, 1.0)
-    _angles, (left, right) = world.wheel_states()
+    robot = make_world()
+    drive(robot, geometry, 0.0, 1.0)
+    run(robot, 1.0)
+    _angles, (left, right) = robot.wheel_states()
     expected = 1.0 * geometry.wheel_separation / 2 / geometry.wheel_radius
     assert (left, right) == pytest.approx((-expected, expected), rel=0.02)

@@ -15,6 +15,10 @@ def write(tmp_path, text, name='world.yaml'):
     return str(path)
 
 
+def obstacles_of(world, worlds_folder):
+    return load_world(world, worlds_folder).obstacles
+
+
 def obstacles_file(tmp_path, *entries):
     return write(tmp_path, 'obstacles:\n' + GOOD + ''.join('  - %s\n' % e for e in entries))
 
@@ -22,23 +26,23 @@ def obstacles_file(tmp_path, *entries):
 # --- the shipped worlds --------------------------------------------------------------
 
 def test_empty_world_has_no_obstacles(worlds_folder):
-    assert load_world('empty', str(worlds_folder)) == []
+    assert obstacles_of('empty', str(worlds_folder)) == []
 
 
 def test_turtlebot3_world_has_6_walls_and_9_pillars(worlds_folder):
-    obstacles = load_world('turtlebot3_world', str(worlds_folder))
+    obstacles = obstacles_of('turtlebot3_world', str(worlds_folder))
     kinds = [obstacle.kind for obstacle in obstacles]
     assert kinds.count('box') == 6 and kinds.count('cylinder') == 9 and len(kinds) == 15
 
 
 def test_turtlebot3_world_obstacles_stand_on_the_ground(worlds_folder):
-    for obstacle in load_world('turtlebot3_world', str(worlds_folder)):
+    for obstacle in obstacles_of('turtlebot3_world', str(worlds_folder)):
         height = obstacle.size[2] if obstacle.kind == 'box' else obstacle.size[1]
         assert obstacle.position[2] == pytest.approx(height / 2.0)
 
 
 def test_turtlebot3_world_walls_form_a_hexagon_of_inradius_2_5(worlds_folder):
-    walls = [o for o in load_world('turtlebot3_world', str(worlds_folder)) if o.kind == 'box']
+    walls = [o for o in obstacles_of('turtlebot3_world', str(worlds_folder)) if o.kind == 'box']
     for wall in walls:
         x, y, _z = wall.position
         assert math.hypot(x, y) == pytest.approx(2.5 + wall.size[1] / 2, abs=0.01)
@@ -52,7 +56,7 @@ def test_turtlebot3_world_walls_form_a_hexagon_of_inradius_2_5(worlds_folder):
 def test_world_given_by_path(tmp_path, worlds_folder):
     path = write(tmp_path, 'obstacles:\n  - box: {size: [1, 2, 0.5], position: [3, -4], yaw: 0.5}\n',
                  name='mine.yaml')
-    (box,) = load_world(path, str(worlds_folder))
+    (box,) = obstacles_of(path, str(worlds_folder))
     assert box.kind == 'box'
     assert box.size == (1.0, 2.0, 0.5)
     assert box.position == (3.0, -4.0, 0.25)
@@ -60,26 +64,26 @@ def test_world_given_by_path(tmp_path, worlds_folder):
 
 
 def test_position_with_z_keeps_z(tmp_path):
-    (pillar,) = load_world(write(tmp_path, 'obstacles:\n  - cylinder: {radius: 0.1, height: 0.4, '
+    (pillar,) = obstacles_of(write(tmp_path, 'obstacles:\n  - cylinder: {radius: 0.1, height: 0.4, '
                                            'position: [1, 2, 0.05]}\n'), str(tmp_path))
     assert pillar.position == (1.0, 2.0, 0.05)
 
 
 def test_defaults_centre_a_shape_at_the_origin_on_the_ground(tmp_path):
-    (pillar,) = load_world(write(tmp_path, 'obstacles:\n' + GOOD), str(tmp_path))
+    (pillar,) = obstacles_of(write(tmp_path, 'obstacles:\n' + GOOD), str(tmp_path))
     assert pillar.size == (0.1, 0.2)
     assert pillar.position == (0.0, 0.0, 0.1)
     assert pillar.yaw == 0.0 and pillar.color == DEFAULT_COLOR
 
 
 def test_color_is_kept(tmp_path):
-    (pillar,) = load_world(write(tmp_path, 'obstacles:\n  - cylinder: {radius: 0.1, height: 0.4, '
+    (pillar,) = obstacles_of(write(tmp_path, 'obstacles:\n  - cylinder: {radius: 0.1, height: 0.4, '
                                            'color: [0.1, 0.2, 0.3, 1]}\n'), str(tmp_path))
     assert pillar.color == (0.1, 0.2, 0.3, 1.0)
 
 
 def test_empty_file_is_an_empty_world(tmp_path):
-    assert load_world(write(tmp_path, ''), str(tmp_path)) == []
+    assert obstacles_of(write(tmp_path, ''), str(tmp_path)) == []
 
 
 # --- malformed files -----------------------------------------------------------------

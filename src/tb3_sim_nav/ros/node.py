@@ -1,0 +1,226 @@
+"""The simulator node: parameters in, a world of robots stepped in sim time, topics and services out.
+
+One physics step gives one timestamp to everything it publishes; each step's
+data goes out before its /clock tick.
+"""
+import dataclasses
+import os
+import sys
+import threading
+import time
+
+import rospkg
+import rospy
+from rosgraph_msgs.msg import Clock
+from std_srvs.srv import Empty, EmptyResponse
+from tf2_msgs.msg import TFMessage
+
+from .. import params
+from ..pacing import Pacer, Schedule
+from ..robot_model import ModelError, load_model, model_urdf
+from ..throttle import Throttle
+from ..world_file import RobotSpec, WorldError, load_world
+from . import rospy_internals
+from .descriptions import Descriptions
+from .lockstep import LOCKSTEP_POLL, LOCKSTEP_POLL_SHARE, Lockstep
+from .master_watch import MasterWatch
+from .publishers import Publishers
+from .robot_io import RobotIO
+
+WARN_PERIOD = 5.0    # s between repeats of the same warning
+IDLE_POLL = 0.01     # wall s between checks while paused or holding
+RESTORED_PARAMETERS = ('/use_sim_time', '/robot_description')  # set again on a new master
+
+
+class SimulatorNode(object):
+    """Steps the simulation in sim time and publishes what Gazebo's TurtleBot3s do."""
+
+    def __init__(self, config, simulation, descriptions):
+        self.config = config
+        self.sim = simulation
+        self.descriptions = descriptions
+        self.pacer = Pacer(config.real_time_factor, paused=config.paused)
+        self._lock = threading.Lock()  # steps versus the services that change the world
+        self._throttle = Throttle(WARN_PERIOD)
+        self._hold_until = 0.0
+        self._due = dict((name, Schedule(round(1e9 / rate))) for name, rate in (
+            ('odom', config.odom_rate), ('joint_states', config.joint_states_rate),
+            ('scan', config.scan_rate), ('imu', config.imu_rate)))
+        self.publishers = Publishers(self._throttle)
+        # Latched: a node that starts gets the time at once, even while paused,
+        # not after a data message stamped later (hztest then measures nothing).
+        self.clock_pub = self.publishers.advertise('clock', Clock, latch=True, on_subscribe=self._hold_clock)
+        self.tf_pub = self.publishers.advertise('tf', TFMessage)
+        self._tf = TFMessage()
+        self.lockstep = None
+        if config.lockstep:
+            # Paced, a step has wall time to spare: look less often, for less CPU.
+            factor = config.real_time_factor
+            poll = max(LOCKSTEP_POLL, LOCKSTEP_POLL_SHARE / config.physics_rate / factor) if factor else LOCKSTEP_POLL
+            self.lockstep = Lockstep(config.lockstep_timeout, poll, self._throttle, WARN_PERIOD)
+        self.robots = {}  # name -> RobotIO
+        for robot in simulation.robots.values():
+            self._add_io(robot)
+        self._own_clock = rospy_internals.stop_following_clock()
+        for name, handler in (('pause_physics', self._on_pause), ('unpause_physics', self._on_unpause),
+                              ('reset_world', self._on_reset_world),
+                              ('reset_simulation', self._on_reset_simulation)):
+            rospy.Service('gazebo/' + name, Empty, handler)
+
+    def _add_io(self, robot):
+        io = self.robots[robot.name] = RobotIO(robot, self.config, self.publishers, self._throttle,
+                                                self._command_received if self.lockstep else None)
+        self._tf.transforms = [other.transform for other in self.robots.values()]
+        if self.lockstep:
+            self.lockstep.follow(io.cmd_vel)
+        self.descriptions.start(robot)
+
+    # --- inputs -------------------------------------------------------------
+    def _command_received(self):
+        self.lockstep.receive_threads.add(threading.get_native_id())
+
+    def _hold_clock(self):
+        """A node has subscribed to /clock: it is starting up. Hold time still
+        while it connects its other topics, so that its first commands are not
+        lost to connection set-up, which takes wall time, not sim time."""
+        self._hold_until = time.monotonic() + self.config.startup_hold
+
+    def _on_pause(self, _request):
+        self.pacer.pause()
+        return EmptyResponse()
+
+    def _on_unpause(self, _request):
+        self.pacer.resume()
+        return EmptyResponse()
+
+    def _on_reset_world(self, _request):
+        with self._lock:
+            self.sim.reset_world()
+        rospy.loginfo('reset_world: every robot back at its spawn pose, odometry zeroed')
+        return EmptyResponse()
+
+    def _on_reset_simulation(self, _request):
+        with self._lock:
+            self.sim.reset_simulation()
+            self.pacer.restart()
+        rospy.loginfo('reset_simulation: every robot back at its spawn pose, time back to zero')
+        return EmptyResponse()
+
+    # --- the step loop ------------------------------------------------------
+    def run(self):
+        step_s = self.sim.step_ns * 1e-9
+        while not rospy.is_shutdown():
+            if self.pacer.paused or time.monotonic() < self._hold_until:
+                self.pacer.restart()
+                self.publishers.flush()
+                time.sleep(IDLE_POLL)
+                continue
+            self.pacer.wait_until((self.sim.steps + 1) * step_s)
+            # Each step waits for the nodes' reaction to the last tick. Paced,
+            # they have had the sleep to react: one look mostly finds them done.
+            if self.lockstep:
+                self.lockstep.wait()
+            with self._lock:
+                self.step()
+
+    def step(self):
+        now_ns = self.sim.now_ns
+        for io in self.robots.values():
+            io.apply_command(now_ns)
+        self.sim.step()
+        now_ns = self.sim.now_ns
+        # One stamp for the whole step, new each step: rospy sends the latched
+        # /clock to a new subscriber from another thread, so it must not change.
+        stamp = rospy.Time(*divmod(now_ns, 1000000000))
+        published = self.publish_data(now_ns, stamp)
+        self.publishers.flush()
+        # The step's data goes out before /clock says its time has come, so a
+        # node woken by the tick reads this step's tf and odom, not the step
+        # before's (lockstep sees that it has): the same at any factor.
+        if published and self.lockstep:
+            self.lockstep.wait()
+        self.clock_pub.publish(Clock(clock=stamp))
+
+    def publish_data(self, now_ns, stamp):
+        """Publishes what is due at `now_ns`; False if nothing was."""
+        due = self._due
+        robots = self.robots.values()
+        published = False
+        if due['odom'].due(now_ns):
+            if self._own_clock:  # the stamps of our log messages need be no finer
+                rospy_internals.set_time(stamp)
+            for io in robots:
+                io.publish_odometry(stamp)
+            self.tf_pub.publish(self._tf)
+            published = True
+        if due['joint_states'].due(now_ns):
+            for io in robots:
+                io.publish_joint_states(stamp)
+            published = True
+        if due['scan'].due(now_ns):
+            for io in robots:
+                published = io.publish_scan(stamp) or published
+        if due['imu'].due(now_ns):
+            now_s = now_ns * 1e-9
+            for io in robots:
+                published = io.publish_imu(stamp, now_s) or published
+        return published
+
+
+def robot_specs(config, world):
+    """The robots to spawn: those of ~robots, or else the one of ~urdf_file
+    without a name (the tutorial's), and then the world file's."""
+    own = list(config.robots) or [RobotSpec('', config.urdf_file, (config.x_pos, config.y_pos, config.z_pos),
+                                            config.yaw)]
+    return own + list(world.robots)
+
+
+def _start_up():
+    """Parameters, models and world checked, the robots placed, or a fatal
+    message and exit status 2."""
+    try:
+        from ..simulation import build
+    except ImportError as error:
+        rospy.logfatal('tb3_sim cannot start: %s. %s has no pybullet: run `make setup` and '
+                       '`source setup.bash`, or see the README on other workspaces', error, sys.executable)
+        sys.exit(2)
+    try:
+        config = params.resolve(lambda name, default: rospy.get_param('~' + name, default))
+        package = rospkg.RosPack().get_path('tb3_sim_nav')
+        world = load_world(config.world, os.path.join(package, 'worlds'))
+        rospy.loginfo('tb3_sim parameters: %s', ', '.join('%s=%r' % (field.name, getattr(config, field.name))
+                                                          for field in dataclasses.fields(config)))
+        robots = []
+        for spec in robot_specs(config, world):
+            model = load_model(model_urdf(spec.model, os.path.join(package, 'urdf')))
+            robots.append((spec.name, model, spec.position + (spec.yaw,)))
+            rospy.loginfo('tb3_sim: robot %s from %s: wheel radius %.4f m, separation %.4f m, limits %g m/s '
+                          'and %g rad/s, at (%.2f, %.2f, %.2f) yaw %.2f', spec.name or '(no namespace)',
+                          model.urdf_file, model.geometry.wheel_radius, model.geometry.wheel_separation,
+                          config.max_linear_speed or model.limits.max_linear,
+                          config.max_angular_speed or model.limits.max_angular, *(spec.position + (spec.yaw,)))
+        rospy.loginfo('tb3_sim: world %r with %d obstacles', config.world, len(world.obstacles))
+        return config, build(config, world.obstacles, robots)
+    except (params.ParameterError, ModelError, WorldError, ValueError) as error:
+        rospy.logfatal('tb3_sim cannot start: %s', error)
+        rospy.signal_shutdown('bad start-up configuration')
+        sys.exit(2)
+
+
+def main():
+    rospy.init_node('tb3_sim')
+    config, simulation = _start_up()
+    if config.real_time_factor == 0.0:
+        # As fast as possible, but only on CPU that no other node wants, so
+        # that rviz and the shell stay responsive (lockstep waits for the
+        # nodes that drive the robot whatever their priority).
+        os.nice(10)
+    restored = dict((name, rospy.get_param(name)) for name in RESTORED_PARAMETERS if rospy.has_param(name))
+    descriptions = Descriptions(restored, config.robot_state_publisher)
+    try:
+        node = SimulatorNode(config, simulation, descriptions)
+        MasterWatch(restored).start()
+        node.run()
+    finally:
+        descriptions.stop_all()
+        simulation.close()
