@@ -108,7 +108,7 @@ def _limits(robot, urdf_path):
         except (TypeError, ValueError):
             value = None
         if value is None or not value > 0.0 or value == float('inf'):
-            raise ModelError('URDF file %r: <drive_limits %s=%r> must be a number > 0'
+            raise ModelError('URDF file %r: <drive_limits %s=%r> must be a number > 0 (and finite)'
                              % (urdf_path, name, element.get(name)))
         values.append(value)
     return Limits(*values)

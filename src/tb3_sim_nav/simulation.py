@@ -32,8 +32,10 @@ class Simulation(object):
         if name in self.robots:
             raise ValueError('two robots are named %r' % name)
         config = self.config
+        # The tutorial's robot has no name: its pose comes from ~x_pos and ~y_pos.
         body = self.world.add_robot(model.urdf_file, pose, name or model.name, model.casters,
-                                    config.wheel_torque, config.ground_friction, config.caster_friction)
+                                    config.wheel_torque, config.ground_friction, config.caster_friction,
+                                    "position (%s's)" % name if name else 'x_pos/y_pos')
         rng = np.random.default_rng(self._seeds.spawn(1)[0])
         robot = self.robots[name] = Robot(name, model, body, config, tuple(pose), rng)
         return robot

@@ -23,7 +23,7 @@ GRAVITY = 9.81           # m/s^2
 GROUND_FRICTION = 1.0    # rubber tyre on a hard floor
 BODY_FRICTION = 0.3      # plastic plates against a wall
 STATIC_BODIES = 2        # Bullet's collision group of bodies with mass 0
-ROBOT_GROUPS = range(2, 32)  # the collision-group bits robots get, one each
+ROBOT_GROUPS = tuple(1 << bit for bit in range(2, 32))  # the collision groups robots get, one each
 MAX_ROBOTS = len(ROBOT_GROUPS)
 
 
@@ -76,16 +76,18 @@ class World(object):
 
     # --- robots ---------------------------------------------------------------
     def add_robot(self, urdf_path, pose, name='robot', casters=(), wheel_torque=1.5,
-                  ground_friction=GROUND_FRICTION, caster_friction=0.0):
+                  ground_friction=GROUND_FRICTION, caster_friction=0.0, pose_names='its position'):
         """A RobotBody loaded at `pose` (x, y, z, yaw), or ValueError when the pose
-        puts it inside an obstacle or another robot (the message names both)."""
-        free = sorted(set(ROBOT_GROUPS) - set(robot.group for robot in self.robots))
+        puts it inside an obstacle or another robot (the message names both, and
+        says to change `pose_names`)."""
+        used = set(robot.group for robot in self.robots)
+        free = [group for group in ROBOT_GROUPS if group not in used]
         if not free:
             raise ValueError('robot %s: a world holds at most %d robots' % (name, MAX_ROBOTS))
-        body = RobotBody(self, urdf_path, pose, name, 1 << free[0], casters, wheel_torque,
+        body = RobotBody(self, urdf_path, pose, name, free[0], casters, wheel_torque,
                          ground_friction, caster_friction)
         try:
-            self._check_clear(body, pose)
+            self._check_clear(body, pose, pose_names)
         except ValueError:
             body.remove()
             raise
@@ -98,20 +100,20 @@ class World(object):
         self.robots.remove(body)
         body.remove()
 
-    def _check_clear(self, body, pose):
+    def _check_clear(self, body, pose, pose_names):
         x, y = pose[:2]
         for index, obstacle in enumerate(self.obstacles):
             if pybullet.getClosestPoints(body.id, obstacle, 0.0, **self._call):
                 centre = pybullet.getBasePositionAndOrientation(obstacle, **self._call)[0]
                 raise ValueError('robot %s: the spawn pose (%.2f, %.2f) puts it inside obstacle %d of '
-                                 'the world, centred at (%.2f, %.2f): choose another pose'
-                                 % (body.name, x, y, index + 1, centre[0], centre[1]))
+                                 'the world, centred at (%.2f, %.2f): choose another %s'
+                                 % (body.name, x, y, index + 1, centre[0], centre[1], pose_names))
         for other in self.robots:
             if pybullet.getClosestPoints(body.id, other.id, 0.0, **self._call):
                 there = other.base_pose()[0]
                 raise ValueError('robot %s: the spawn pose (%.2f, %.2f) puts it inside robot %s, '
-                                 'at (%.2f, %.2f): choose another pose'
-                                 % (body.name, x, y, other.name, there[0], there[1]))
+                                 'at (%.2f, %.2f): choose another %s'
+                                 % (body.name, x, y, other.name, there[0], there[1], pose_names))
 
     def _aim_camera(self, spawn_pose):
         """pybullet's window: no side panels, looking over the robot's shoulder, as demo.rviz."""

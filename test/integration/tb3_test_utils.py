@@ -315,6 +315,27 @@ def report(name, **values):
 
 
 # --- commands ------------------------------------------------------------------
+TURN_TOLERANCE = math.radians(0.5)
+
+
+def turn_to(truth, publisher, heading, timeout, tolerance=TURN_TOLERANCE):
+    """Turn on the spot, closed loop on `truth` (a GroundTruth), until its yaw is
+    within `tolerance` of `heading`; True if it got there within `timeout` wall s.
+    Leaves the robot commanded to stop."""
+    from geometry_msgs.msg import Twist
+    command = Twist()
+    repeater = Repeater(publisher, command, rate=20.0)
+    try:
+        def turned():
+            error = wrap(heading - truth.latest().yaw)
+            command.angular.z = math.copysign(min(1.0, max(0.1, 2.0 * abs(error))), error)
+            return abs(error) < tolerance
+        return wait_for(turned, timeout, poll=0.01)
+    finally:
+        repeater.stop()
+        publisher.publish(Twist())
+
+
 class Repeater(object):
     """Publishes `message` on `publisher` at `rate` Hz of wall time until stop(),
     as `rostopic pub -r` would; `message` may be changed while it runs."""

@@ -23,7 +23,7 @@ import rostest
 from geometry_msgs.msg import Twist
 
 from tb3_test_utils import (wait_for_simulator, GroundTruth3D, Repeater, finite_difference_speeds, init_test_node,
-                            report, speed, wait_for, wall_budget, wrap)
+                            report, speed, turn_to, wall_budget, wrap)
 
 WALL_FACE_X = -2.5            # inner face of the west wall (m)
 WALL_Y_EXTENT = 1.49          # the west wall spans |y| below this (m)
@@ -36,7 +36,6 @@ STILL_WINDOW = 2.0            # sim s at the end of the push that must be still
 STOPPED_SPEED = 0.01          # m/s
 MAX_HEIGHT = 0.02             # m
 MAX_TILT_DEG = 5.0
-TURN_TOLERANCE = math.radians(0.5)
 
 
 class WallCollision(unittest.TestCase):
@@ -54,26 +53,10 @@ class WallCollision(unittest.TestCase):
             cls.cmd_vel.publish(Twist())
 
     @classmethod
-    def _turn_to(cls, heading, timeout):
-        """Turn on the spot until ground truth's yaw is within TURN_TOLERANCE of `heading`."""
-        command = Twist()
-        repeater = Repeater(cls.cmd_vel, command, rate=20.0)
-        try:
-            def turned():
-                error = wrap(heading - cls.truth.latest().yaw)
-                command.angular.z = math.copysign(min(1.0, max(0.1, 2.0 * abs(error))), error)
-                return abs(error) < TURN_TOLERANCE
-            done = wait_for(turned, timeout, poll=0.01)
-        finally:
-            repeater.stop()
-            cls.cmd_vel.publish(Twist())
-        return done
-
-    @classmethod
     def _run(cls):
         truth = cls.truth
         wait_for_simulator(truth, cls.cmd_vel)
-        if not cls._turn_to(math.pi, wall_budget(15.0)):
+        if not turn_to(truth, cls.cmd_vel, math.pi, wall_budget(15.0)):
             raise AssertionError('could not turn to face -x: yaw %.1f deg' % math.degrees(truth.latest().yaw))
         cls.facing = truth.wait_at_rest(timeout=wall_budget(3.0))
         if cls.facing is None:

@@ -3,7 +3,7 @@ import xml.etree.ElementTree as ElementTree
 
 import pytest
 
-from tb3_sim_nav.robot_model import (ModelError, read_drive_geometry, root_link,
+from tb3_sim_nav.robot_model import (ModelError, load_model, model_urdf, read_drive_geometry, root_link,
                                      urdf_for_pybullet)
 
 WHEEL_LINK = ('<link name="{0}"><collision><geometry><sphere radius="0.033"/></geometry>'
@@ -146,3 +146,38 @@ def test_shipped_wheel_joints_spin_about_the_axle(burger_urdf):
 def test_shipped_base_link_mass(burger_urdf):
     mass = shipped(burger_urdf).find("link[@name='base_link']/inertial/mass")
     assert float(mass.get('value')) == pytest.approx(0.83, abs=0.01)
+
+
+# --- load_model: limits and casters; model_urdf ------------------------------------------
+
+def test_the_burger_model_has_robotis_limits_and_its_caster(burger_urdf):
+    model = load_model(str(burger_urdf))
+    assert model.name == 'turtlebot3_burger'
+    assert model.limits == (0.22, 2.84)
+    assert model.geometry == pytest.approx((0.033, 0.160))
+    assert model.casters == ('caster_back_link',)
+
+
+def test_a_urdf_without_drive_limits_is_refused_naming_the_element(tmp_path):
+    path = write(tmp_path, two_wheels(), name='limitless.urdf')
+    with pytest.raises(ModelError, match='limitless.urdf.*drive_limits'):
+        load_model(str(path))
+
+
+@pytest.mark.parametrize('attributes', ['max_linear_speed="0.2"', 'max_linear_speed="0" max_angular_speed="1"',
+                                        'max_linear_speed="fast" max_angular_speed="1"',
+                                        'max_linear_speed="0.2" max_angular_speed="inf"'])
+def test_bad_drive_limits_are_refused(tmp_path, attributes):
+    path = write(tmp_path, two_wheels() + '<drive_limits %s/>' % attributes, name='bad_limits.urdf')
+    with pytest.raises(ModelError, match="bad_limits.urdf': <drive_limits max_"):
+        load_model(str(path))
+
+
+def test_models_by_name_are_urdfs_of_the_folder_and_paths_are_paths(tmp_path):
+    assert model_urdf('waffle_pi', '/pkg/urdf') == '/pkg/urdf/turtlebot3_waffle_pi.urdf'
+    assert model_urdf(str(tmp_path / 'mine.urdf'), '/pkg/urdf') == str(tmp_path / 'mine.urdf')
+
+
+def test_an_unknown_model_is_refused_naming_the_three(tmp_path):
+    with pytest.raises(ModelError, match="unknown TurtleBot3 model 'wafle': the models are burger, waffle, waffle_pi"):
+        model_urdf('wafle', '/pkg/urdf')

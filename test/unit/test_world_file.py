@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from tb3_sim_nav.world_file import DEFAULT_COLOR, WorldError, load_world
+from tb3_sim_nav.world_file import DEFAULT_COLOR, RobotSpec, WorldError, load_world
 
 # A valid first obstacle, so that errors must name the second one.
 GOOD = '  - cylinder: {radius: 0.1, height: 0.2}\n'
@@ -182,3 +182,53 @@ def test_malformed_value_is_shown(tmp_path, entry, shown):
 
 def test_world_error_is_a_value_error():
     assert issubclass(WorldError, ValueError)
+
+
+# --- names and robots ------------------------------------------------------------------
+
+def test_obstacles_may_have_names(tmp_path):
+    (wall, pillar) = obstacles_of(write(tmp_path, 'obstacles:\n  - box: {size: [1, 1, 1], name: north_wall}\n'
+                                        + GOOD), str(tmp_path))
+    assert wall.name == 'north_wall' and pillar.name == ''
+
+
+def test_two_obstacles_with_one_name_are_refused_by_name(tmp_path):
+    path = write(tmp_path, 'obstacles:\n  - box: {size: [1, 1, 1], name: w}\n  - box: {size: [1, 1, 1], name: w}\n')
+    with pytest.raises(WorldError, match="two obstacles are named 'w'"):
+        load_world(path, str(tmp_path))
+
+
+def test_a_world_lists_robots_with_name_model_and_pose(tmp_path):
+    world = load_world(write(tmp_path, 'robots:\n'
+                                       '  - {name: tb3_3, model: waffle, position: [1.0, -2.0], yaw: 1.5}\n'
+                                       '  - {name: scout, model: burger, position: [0, 0, 0.01]}\n'), str(tmp_path))
+    assert world.obstacles == []
+    assert world.robots == [RobotSpec('tb3_3', 'waffle', (1.0, -2.0, 0.0), 1.5),
+                            RobotSpec('scout', 'burger', (0.0, 0.0, 0.01), 0.0)]
+
+
+@pytest.mark.parametrize('entry, shown', [
+    ('{model: burger, position: [0, 0]}', "missing ['name']"),
+    ('{name: a, position: [0, 0]}', "missing ['model']"),
+    ('{name: a, model: burger}', "missing ['position']"),
+    ('{name: a, model: burger, position: [0, 0], colour: red}', "unknown ['colour']"),
+    ('{name: 3a, model: burger, position: [0, 0]}', "name '3a' must be a ROS name"),
+    ('{name: a/b, model: burger, position: [0, 0]}', "name 'a/b' must be a ROS name"),
+    ('{name: a, model: 5, position: [0, 0]}', 'model must be burger, waffle, waffle_pi or a URDF path'),
+    ('{name: a, model: burger, position: [0]}', 'robot a: position must be a list of 2 or 3 finite numbers'),
+    ('{name: a, model: burger, position: [0, .nan]}', 'robot a: position must be a list of 2 or 3 finite'),
+    ('{name: a, model: burger, position: [0, 0], yaw: up}', 'robot a: yaw must be a list of 1 finite'),
+    ('tb3_0', 'must be a mapping of name, model, position and yaw'),
+])
+def test_a_bad_robot_entry_is_refused_naming_file_entry_and_problem(tmp_path, entry, shown):
+    path = write(tmp_path, 'robots:\n  - {name: ok, model: burger, position: [5, 5]}\n  - %s\n' % entry)
+    with pytest.raises(WorldError) as error:
+        load_world(path, str(tmp_path))
+    assert path in str(error.value) and 'robot 2' in str(error.value) and shown in str(error.value)
+
+
+def test_two_robots_with_one_name_in_a_world_are_refused(tmp_path):
+    path = write(tmp_path, 'robots:\n  - {name: a, model: burger, position: [0, 0]}\n'
+                           '  - {name: a, model: burger, position: [1, 0]}\n')
+    with pytest.raises(WorldError, match="two robots are named 'a'"):
+        load_world(path, str(tmp_path))
