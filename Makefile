@@ -47,8 +47,10 @@ unit: setup
 integration: setup
 	$(IN_ROS) bash tools/run_tests.sh --integration-only
 
+# The packages as the workspace holds them: catkin_lint wants a package's
+# folder named as the package, and a clone's may not be.
 lint: setup
-	$(IN_ROS) catkin_lint --strict -W2 . gazebo_msgs
+	$(IN_ROS) catkin_lint --strict -W2 "$$(rospack find tb3_sim_nav)" "$$(rospack find gazebo_msgs)"
 
 bench: setup
 	$(IN_ROS) python3 tools/bench.py $(BENCH_ARGS)
