@@ -21,12 +21,16 @@ $(VENV)/.ready: tools/requirements.txt
 # The workspace's copy of the package is a folder of links to the repo's
 # top-level entries, not one link to the repo: rosrun searches the package
 # folder with `find -L`, which would loop through $(WS) and crawl $(VENV).
+# gazebo_msgs, a package folder inside this one, gets a link of its own: catkin
+# does not look for packages inside a package.
 # catkin_make again whenever what it generates from could have changed.
-$(WS)/devel/.ready: CMakeLists.txt package.xml setup.py env-hooks/* $(wildcard scripts/*) $(wildcard test/*.test) | $(VENV)/.ready
+GAZEBO_MSGS := gazebo_msgs/CMakeLists.txt gazebo_msgs/package.xml $(wildcard gazebo_msgs/msg/* gazebo_msgs/srv/*)
+$(WS)/devel/.ready: CMakeLists.txt package.xml setup.py env-hooks/* $(wildcard scripts/*) $(wildcard test/*.test) $(GAZEBO_MSGS) | $(VENV)/.ready
 	[ ! -L $(WS)/src/tb3_sim_nav ] || rm $(WS)/src/tb3_sim_nav
 	mkdir -p $(WS)/src/tb3_sim_nav
 	find $(WS)/src/tb3_sim_nav -maxdepth 1 -type l -delete
 	for entry in *; do ln -s "$(CURDIR)/$$entry" "$(WS)/src/tb3_sim_nav/$$entry"; done
+	ln -sfn "$(CURDIR)/gazebo_msgs" $(WS)/src/gazebo_msgs
 	cd $(WS) && catkin_make -DPYTHON_EXECUTABLE=$(PYTHON) -DCATKIN_ENABLE_TESTING=ON > build.log 2>&1 \
 	  || { tail -40 build.log; exit 1; }
 	touch $@
@@ -43,8 +47,10 @@ unit: setup
 integration: setup
 	$(IN_ROS) bash tools/run_tests.sh --integration-only
 
+# The packages as the workspace holds them: catkin_lint wants a package's
+# folder named as the package, and a clone's may not be.
 lint: setup
-	$(IN_ROS) catkin_lint --strict -W2 .
+	$(IN_ROS) catkin_lint --strict -W2 "$$(rospack find tb3_sim_nav)" "$$(rospack find gazebo_msgs)"
 
 bench: setup
 	$(IN_ROS) python3 tools/bench.py $(BENCH_ARGS)

@@ -31,7 +31,7 @@ if [ "${1:-}" != --integration-only ]; then
   echo "== unit tests (pytest, no master)"
   run unit python3 -m pytest -q -p no:cacheprovider test/unit
   echo "== catkin_lint"
-  lint=$(catkin_lint --strict -W2 "$(rospack find tb3_sim_nav)" 2>&1)
+  lint=$(catkin_lint --strict -W2 "$(rospack find tb3_sim_nav)" "$(rospack find gazebo_msgs)" 2>&1)
   echo "$lint" | tee "$logs/catkin_lint"
   echo "$lint" | grep -qE ': (error|warning|notice):' && failures+=(catkin_lint)
 fi
