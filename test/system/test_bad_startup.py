@@ -32,8 +32,8 @@ def cases(tmp_path):
         # name: (launch file, arguments, what an error line must contain)
         'negative_real_time_factor': ('tb3_empty_world.launch', ['real_time_factor:=-1'],
                                       ['real_time_factor', '-1']),
-        'missing_urdf_model_waffle': ('tb3_empty_world.launch', ['model:=waffle'],
-                                      ['turtlebot3_waffle.urdf']),
+        'missing_urdf_model': ('tb3_empty_world.launch', ['model:=no_such_model'],
+                               ['turtlebot3_no_such_model.urdf']),
         'missing_world_file': ('tb3_empty_world.launch', ['world:=/nonexistent.yaml'],
                                ['world', '/nonexistent.yaml']),
         'malformed_world_file': ('tb3_empty_world.launch', ['world:=%s' % malformed],
@@ -46,7 +46,7 @@ def cases(tmp_path):
     }
 
 
-CASES = ['negative_real_time_factor', 'missing_urdf_model_waffle', 'missing_world_file',
+CASES = ['negative_real_time_factor', 'missing_urdf_model', 'missing_world_file',
          'malformed_world_file', 'spawn_inside_central_pillar', 'real_time_factor_not_a_number']
 
 
