@@ -11,73 +11,44 @@ import argparse
 import datetime
 import math
 import os
-import platform
 import statistics
 import sys
 import time
-import xmlrpc.client
 
-import demo
-import demo_report
-from demo import Process, say
-from tcpros_reader import TcprosReader
+from tb3_harness import report, tutorial
+from tb3_harness.measure import cpu_seconds, machine, memory_mib, sim_pid, sim_uri
+from tb3_harness.processes import Process, RunError, say, start_master, wait_until
+from tb3_harness.tcpros_reader import TcprosReader
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 LAUNCH = ['roslaunch', '--wait', 'tb3_sim_bringup']
 EMPTY_WORLD, WALLED_WORLD = 'tb3_empty_world.launch', 'tb3_world.launch'  # the tutorial's two
-TOPICS = ['clock', 'odom', 'tf', 'joint_states', 'base_pose_ground_truth', 'scan', 'imu']
-# (label, launch file, sensors switched off, read by a rospy node). Each
-# topic is read by a TcprosReader (nearly free), or by one rospy node, which
-# handles each message in python. In the empty world no lidar beam can hit
-# anything, and none is cast: the walled world casts them.
-RTF_ROWS = [('every topic on', EMPTY_WORLD, {}, False),
-            ('without scan', EMPTY_WORLD, {'scan': False}, False),
-            ('without imu', EMPTY_WORLD, {'imu': False}, False),
-            ('without scan and imu', EMPTY_WORLD, {'scan': False, 'imu': False}, False),
-            ('every topic on, in turtlebot3_world', WALLED_WORLD, {}, False),
-            ('every topic on, read by a rospy node', EMPTY_WORLD, {}, True)]
+MULTI = 'multi_tb3.launch'  # three robots in turtlebot3_world
+GLOBAL_TOPICS = ['clock', 'tf']
+ROBOT_TOPICS = ['odom', 'joint_states', 'base_pose_ground_truth', 'scan', 'imu']
+TOPICS = GLOBAL_TOPICS + ROBOT_TOPICS
+THREE = ['tb3_0', 'tb3_1', 'tb3_2']
+#: Seven more robots for ten in turtlebot3_world, between the pillars.
+SEVEN = [('tb3_%d' % (3 + index), position) for index, position in enumerate(
+    [(0.55, 0.55), (-0.55, 0.55), (0.55, -0.55), (-0.55, -0.55), (1.65, 0.55), (1.65, -0.55), (0.55, 1.65)])]
+# (label, launch file, its robots' names, sensors switched off, read by a
+# rospy node, target). Each topic of each robot is read by a TcprosReader
+# (nearly free), or by one rospy node, which handles each message in python.
+# In the empty world no lidar beam can hit anything, and none is cast;
+# turtlebot3_world casts them.
+RTF_ROWS = [('1 robot, empty world, every topic read', EMPTY_WORLD, [''], {}, False, None),
+            ('  the same without scan', EMPTY_WORLD, [''], {'scan': False}, False, None),
+            ('  the same without imu', EMPTY_WORLD, [''], {'imu': False}, False, None),
+            ('  the same without scan and imu', EMPTY_WORLD, [''], {'scan': False, 'imu': False}, False, None),
+            ('  the same, every topic read by a rospy node', EMPTY_WORLD, [''], {}, True, None),
+            ('1 robot, turtlebot3_world, every topic read', WALLED_WORLD, [''], {}, False, 30.0),
+            ('3 robots, turtlebot3_world, every topic read', MULTI, THREE, {}, False, 10.0),
+            ('10 robots, turtlebot3_world, every topic read', MULTI, THREE + [name for name, _ in SEVEN], {},
+             False, None)]
 CPU_SCRIPT = 'odom_out_and_back.py'  # the tutorial script that reads tf
-TARGETS = {'rtf': 30.0, 'cpu': 5.0, 'startup': 3.0, 'speedup': 10.0}
-
-
-def machine():
-    model = 'unknown CPU'
-    with open('/proc/cpuinfo') as cpuinfo:
-        for line in cpuinfo:
-            if line.startswith('model name'):
-                model = line.split(':', 1)[1].strip()
-                break
-    return '%s, %d cores, %s, Python %s' % (model, os.cpu_count(), platform.platform(terse=True),
-                                            platform.python_version())
-
-
-def sim_uri():
-    """XML-RPC URI of the /tb3_sim node, or None while it is not registered."""
-    import rosgraph
-    try:
-        return rosgraph.Master('/tb3_bench').lookupNode('/tb3_sim')
-    except rosgraph.MasterException:
-        return None
-
-
-def sim_pid():
-    """PID of the /tb3_sim node, from its own XML-RPC API."""
-    return xmlrpc.client.ServerProxy(sim_uri()).getPid('/tb3_bench')[2]
-
-
-def cpu_seconds(pid):
-    """User + system CPU time (s) of a process and its threads."""
-    with open('/proc/%d/stat' % pid) as stat:
-        fields = stat.read().rsplit(')', 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
-
-
-def memory_mib(pid, field='VmHWM'):
-    """A memory figure of /proc/PID/status in MiB: VmHWM (peak RSS) or VmRSS (now)."""
-    with open('/proc/%d/status' % pid) as status:
-        for line in status:
-            if line.startswith(field + ':'):
-                return int(line.split()[1]) / 1024.0
-    return float('nan')
+PHYSICS_RATE = 100.0  # the simulator's default steps per sim second
+TARGETS = {'cpu': 5.0, 'startup': 3.0, 'speedup': 10.0}
 
 
 class Listener(object):
@@ -110,42 +81,49 @@ class Listener(object):
         self.subscribers = []
 
 
-def start_sim(name, log_dir, factor, launch=EMPTY_WORLD, sensors=None):
+def start_sim(name, log_dir, factor, launch=EMPTY_WORLD, sensors=None, robots=('',)):
     """One of the tutorial's launches at `factor`; `sensors` maps 'scan' and
-    'imu' to False to switch them off (private parameters of /tb3_sim)."""
+    'imu' to False to switch them off (private parameters of /tb3_sim); more
+    than three `robots`: the seven of SEVEN join multi_tb3.launch's three."""
     import rosgraph
     master = rosgraph.Master('/tb3_bench')
     for key in ('scan', 'imu'):
         master.setParam('/tb3_sim/' + key, (sensors or {}).get(key, True))
-    return Process(name, LAUNCH + [launch, 'real_time_factor:=%g' % factor], log_dir)
+    argv = LAUNCH + [launch, 'real_time_factor:=%g' % factor]
+    if len(robots) > len(THREE):
+        world = os.path.join(log_dir, 'ten_robots.yaml')
+        with open(os.path.join(ROOT, 'worlds', 'turtlebot3_world.yaml')) as walls, open(world, 'w') as ten:
+            ten.write(walls.read() + 'robots:\n' + ''.join(
+                '  - {name: %s, model: burger, position: [%g, %g]}\n' % ((name,) + position)
+                for name, position in SEVEN))
+        argv.append('world:=' + world)
+    return Process(name, argv, log_dir)
 
 
-def wait_until(predicate, timeout, what):
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            raise demo.DemoError('no %s within %.0f s' % (what, timeout))
-        time.sleep(0.01)
-
-
-def measure_rtf(log_dir, launch, sensors, seconds, rospy_reader=False):
-    """Sim seconds per wall second at factor 0, and the node's peak RSS. Every
-    topic is read by a TcprosReader, or with `rospy_reader` by a rospy node."""
+def measure_rtf(log_dir, launch, robots, sensors, seconds, rospy_reader=False):
+    """At factor 0: sim seconds per wall second, the node's CPU per step (us) and
+    its peak RSS. Every topic of every robot is read by a TcprosReader, or with
+    `rospy_reader` by a rospy node."""
     listener = Listener() if rospy_reader else None
-    sim = start_sim('rtf', log_dir, 0.0, launch, sensors)
+    sim = start_sim('rtf', log_dir, 0.0, launch, sensors, robots)
     readers = []
     try:
         if listener is None:
-            readers = [TcprosReader(sim_uri, '/' + topic) for topic in TOPICS if sensors.get(topic, True)]
-            clock = next(reader for reader in readers if reader.topic == '/clock')
+            topics = ['/' + topic for topic in GLOBAL_TOPICS] + [
+                '/' + robot + ('/' if robot else '') + topic for robot in robots for topic in ROBOT_TOPICS
+                if sensors.get(topic, True)]
+            readers = [TcprosReader(sim_uri, topic) for topic in topics]
+            clock = readers[0]
         else:
             clock = listener
-        wait_until(lambda: clock.clock is not None and clock.clock > 1.0, 60, '/clock')
+        wait_until(lambda: clock.clock is not None and clock.clock > 1.0, 120, '/clock')
         time.sleep(1.0)
-        sim_start, wall_start = clock.clock, time.monotonic()
+        pid = sim_pid()
+        sim_start, wall_start, cpu_start = clock.clock, time.monotonic(), cpu_seconds(pid)
         time.sleep(seconds)
-        rtf = (clock.clock - sim_start) / (time.monotonic() - wall_start)
-        return rtf, memory_mib(sim_pid())
+        sim_end, wall_end, cpu_end = clock.clock, time.monotonic(), cpu_seconds(pid)
+        steps = (sim_end - sim_start) * PHYSICS_RATE
+        return (sim_end - sim_start) / (wall_end - wall_start), 1e6 * (cpu_end - cpu_start) / steps, memory_mib(pid)
     finally:
         for reader in readers:
             reader.close()
@@ -199,7 +177,7 @@ def measure_cpu_of_script(log_dir, script):
         finally:
             driver.stop()
         if driver.popen.returncode != 0:
-            raise demo.DemoError('%s exited with code %s; see %s' % (script, driver.popen.returncode, driver.log))
+            raise RunError('%s exited with code %s; see %s' % (script, driver.popen.returncode, driver.log))
         return 100.0 * (cpu_seconds(pid) - cpu_start) / (time.monotonic() - wall_start)
     finally:
         listener.close()
@@ -210,7 +188,7 @@ def measure_floor(log_dir, seconds, physics):
     """CPU of tools/clock_floor.py, which only sleeps to each tick and
     publishes /clock (with `physics`, steps pybullet too): for scale."""
     listener = Listener(topics=('clock',))
-    argv = [sys.executable, os.path.join(demo.ROOT, 'tools', 'clock_floor.py')] + (['--physics'] if physics else [])
+    argv = [sys.executable, os.path.join(ROOT, 'tools', 'clock_floor.py')] + (['--physics'] if physics else [])
     floor = Process('floor' + ('_physics' if physics else ''), argv, log_dir)
     try:
         wait_until(lambda: listener.clock is not None, 60, '/clock from clock_floor.py')
@@ -227,11 +205,11 @@ def run_scripts(log_dir, factor):
     """Each tutorial script on a fresh simulator at `factor`: wall time and end pose."""
     options = argparse.Namespace(real_time_factor=factor, profile=None)
     results = {}
-    for script, expected in demo.SCRIPTS:
-        result, error = demo.run_script(script, expected, options, log_dir)
+    for script, expected in tutorial.SCRIPTS:
+        result, error = tutorial.run_script(script, expected, options, log_dir)
         if error:
-            raise demo.DemoError('%s at factor %g: %s' % (script, factor, error))
-        results[script] = (result.wall_time, demo_report.summarize(result).end)
+            raise RunError('%s at factor %g: %s' % (script, factor, error))
+        results[script] = (result.wall_time, report.summarize(result).end)
     return results
 
 
@@ -252,24 +230,25 @@ def main(argv=None):
                         help='comma-separated: rtf (max real-time factor), cpu (CPU, memory, start-up), '
                              'floor (CPU of a bare /clock loop, for scale), '
                              'scripts (the tutorial scripts at factor 1 and 0); default all')
-    parser.add_argument('--output', default=os.path.join(demo.ROOT, 'bench_output'))
+    parser.add_argument('--output', default=os.path.join(ROOT, 'bench_output'))
     args = parser.parse_args(argv)
     log_dir = os.path.join(args.output, 'logs')
     os.makedirs(log_dir, exist_ok=True)
     master = None
     lines = []
     try:
-        master = demo.start_master(log_dir)
+        master = start_master(log_dir)
         import rospy
         rospy.init_node('tb3_bench', anonymous=True, argv=[sys.argv[0]], disable_signals=True)
         parts = args.parts.split(',')
-        rtf, rss = {}, []
-        for label, launch, sensors, rospy_reader in (RTF_ROWS if 'rtf' in parts else []):
-            rtf[label] = []
+        rtf, step_cost, rss = {}, {}, []
+        for label, launch, robots, sensors, rospy_reader, _ in (RTF_ROWS if 'rtf' in parts else []):
+            rtf[label], step_cost[label] = [], []
             for run in range(args.runs):
-                value, peak = measure_rtf(log_dir, launch, sensors, args.seconds, rospy_reader)
-                say('max real-time factor, %s, run %d: %.1f' % (label, run + 1, value))
+                value, cost, peak = measure_rtf(log_dir, launch, robots, sensors, args.seconds, rospy_reader)
+                say('%s, run %d: real-time factor %.1f, %.0f us of CPU a step' % (label, run + 1, value, cost))
                 rtf[label].append(value)
+                step_cost[label].append(cost)
                 rss.append(peak)
         cpu, cpu_script, startup = [], [], []
         for run in range(args.runs if 'cpu' in parts else 0):
@@ -296,11 +275,12 @@ def main(argv=None):
                   'medians of %d runs; real-time factor = sim seconds per wall second' % args.runs, '',
                   '%-58s %12s  %s' % ('figure', 'value', 'target')]
         if rtf:
-            full = median(rtf['every topic on'])
-            lines.append('%-58s %12.1f  >= %g: %s' % ('max real-time factor, headless empty world, every topic on',
-                                                     full, TARGETS['rtf'], verdict(full >= TARGETS['rtf'])))
-            for label, _, _, _ in RTF_ROWS[1:]:
-                lines.append('%-58s %12.1f' % ('max real-time factor, ' + label, median(rtf[label])))
+            lines.append('max real-time factor (factor 0), and CPU of the simulator per step:')
+            for label, _, _, _, _, target in RTF_ROWS:
+                value = median(rtf[label])
+                lines.append('%-58s %12.1f  %6.0f us/step%s' % (
+                    '  ' + label, value, median(step_cost[label]),
+                    '  >= %g: %s' % (target, verdict(value >= target)) if target else ''))
         if cpu:
             lines += ['%-58s %11.1f%%  < %g %%: %s' % ('CPU of the simulator at factor 1, driving, all topics read',
                                                        median(cpu), TARGETS['cpu'], verdict(median(cpu) < TARGETS['cpu'])),
@@ -315,18 +295,18 @@ def main(argv=None):
                       '%-58s %11.1f%%' % ('  floor: the same, a pybullet step each tick', median(floor[True]))]
         if rss:
             lines.append('%-58s %8.0f MiB' % ('peak RSS of the simulator node (max over runs)', max(rss)))
-        for script, _ in (demo.SCRIPTS if scripts else []):
+        for script, _ in (tutorial.SCRIPTS if scripts else []):
             (wall_1, end_1), (wall_0, end_0) = scripts[1.0][script], scripts[0.0][script]
             ratio = wall_1 / wall_0
             apart = math.hypot(end_0[1] - end_1[1], end_0[2] - end_1[2])
-            turn = abs(math.degrees(demo_report.normalize(end_0[3] - end_1[3])))
+            turn = abs(math.degrees(report.normalize(end_0[3] - end_1[3])))
             lines += ['%-58s %7.1f s / %.1f s = %.1fx  >= %gx: %s'
                       % (script + ' wall time, factor 1 / factor 0', wall_1, wall_0, ratio,
                          TARGETS['speedup'], verdict(ratio >= TARGETS['speedup'])),
                       '%-58s %6.3f m %5.2f deg  (ends %+.3f %+.3f %+.1f deg / %+.3f %+.3f %+.1f deg)'
                       % ('  end pose, factor 0 against factor 1', apart, turn,
                          end_1[1], end_1[2], math.degrees(end_1[3]), end_0[1], end_0[2], math.degrees(end_0[3]))]
-    except demo.DemoError as error:
+    except RunError as error:
         print('bench FAILED: %s' % error, file=sys.stderr)
         return 1
     finally:

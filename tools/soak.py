@@ -23,8 +23,10 @@ import sys
 import time
 
 import bench
-import demo
-from demo import say
+from tb3_harness.measure import machine, memory_mib, sim_pid
+from tb3_harness.processes import Process, RunError, say, start_master, wait_until
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 LIMIT_MARGIN = 1.05
 HOSTILE = [float('nan'), float('inf'), -float('inf'), 1e308, -1e308, -0.0, 5.0, -5.0, 40.0]
@@ -113,7 +115,7 @@ def main(argv=None):
     parser.add_argument('--seed', type=int, default=1)
     parser.add_argument('--check', action='store_true', help='exit 1 if a target is missed')
     parser.add_argument('--flood', action='store_true', help=argparse.SUPPRESS)
-    parser.add_argument('--output', default=os.path.join(demo.ROOT, 'soak_output'))
+    parser.add_argument('--output', default=os.path.join(ROOT, 'soak_output'))
     args = parser.parse_args(argv)
     if args.flood:
         return flood(args.burst, args.seed)
@@ -121,17 +123,17 @@ def main(argv=None):
     os.makedirs(log_dir, exist_ok=True)
     master = sim = checker = commands = None
     try:
-        master = demo.start_master(log_dir)
+        master = start_master(log_dir)
         import rospy
         from geometry_msgs.msg import Twist
         rospy.init_node('tb3_soak', anonymous=True, argv=[sys.argv[0]], disable_signals=True)
         checker = Checker()
         clock = checker  # its /clock subscriber tells sim time
         sim = bench.start_sim('soak', log_dir, 0.0)
-        bench.wait_until(lambda: clock.clock is not None and clock.clock > 2.0, 60, '/clock')
-        pid = bench.sim_pid()
-        warm = bench.memory_mib(pid, 'VmRSS')
-        commands = demo.Process('flood', [sys.executable, __file__, '--flood', '--burst', str(args.burst),
+        wait_until(lambda: clock.clock is not None and clock.clock > 2.0, 60, '/clock')
+        pid = sim_pid()
+        warm = memory_mib(pid, 'VmRSS')
+        commands = Process('flood', [sys.executable, __file__, '--flood', '--burst', str(args.burst),
                                           '--seed', str(args.seed)], log_dir)
         received = []
         counter = rospy.Subscriber('cmd_vel', Twist, received.append, queue_size=1)
@@ -141,15 +143,15 @@ def main(argv=None):
         while clock.clock - sim_start < args.sim_seconds:
             for process in (sim, commands):
                 if not process.running():
-                    raise demo.DemoError('%s exited (code %s); see %s'
+                    raise RunError('%s exited (code %s); see %s'
                                          % (process.name, process.popen.returncode, process.log))
             if clock.clock - sim_start >= next_report:
-                say('soak: sim %.0f s, VmRSS %.1f MiB' % (clock.clock - sim_start, bench.memory_mib(pid, 'VmRSS')))
+                say('soak: sim %.0f s, VmRSS %.1f MiB' % (clock.clock - sim_start, memory_mib(pid, 'VmRSS')))
                 next_report += max(60.0, args.sim_seconds / 10)
             time.sleep(0.1)
         counter.unregister()
         sent = len(received)
-        growth = bench.memory_mib(pid, 'VmRSS') - warm
+        growth = memory_mib(pid, 'VmRSS') - warm
         wall = time.monotonic() - wall_start
         # Whole simulated seconds, leaving out the first and last (partly seen).
         counts = [count for second, count in sorted(checker.tf_per_second.items())][2:-1]
@@ -166,7 +168,7 @@ def main(argv=None):
              not checker.non_finite),
             ('fastest ground truth |v|, |w|', '%.3f m/s, %.2f rad/s' % checker.fastest, limits_ok),
         ]
-        print('\ntb3_sim_nav soak, machine: %s' % bench.machine())
+        print('\ntb3_sim_nav soak, machine: %s' % machine())
         for name, value, ok in results:
             print('%-62s %22s  %s' % (name, value, 'ok' if ok else 'MISSED'))
         failed = [name for name, _, ok in results if not ok]
@@ -175,7 +177,7 @@ def main(argv=None):
         if checker.non_finite:
             print('first non-finite: %r' % (checker.non_finite[0],))
         return 1 if failed and args.check else 0
-    except demo.DemoError as error:
+    except RunError as error:
         print('soak FAILED: %s' % error, file=sys.stderr)
         return 1
     finally:

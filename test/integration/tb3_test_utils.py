@@ -8,21 +8,17 @@ physics is paused); sim-time durations are waited for as the condition
 "the latest ground-truth stamp has reached t".
 """
 import atexit
-import ctypes
 import math
 import os
-import signal
-import subprocess
-import tempfile
 import threading
 import time
 from collections import namedtuple
 
 import rospy
 from nav_msgs.msg import Odometry
+from tb3_harness.processes import Process
 
 GROUND_TRUTH = '/base_pose_ground_truth'
-PR_SET_PDEATHSIG = 1
 
 Sample = namedtuple('Sample', 't x y yaw vx vy wz')
 #: A Sample with the height and tilt too (GroundTruth3D).
@@ -215,77 +211,26 @@ class GroundTruth3D(GroundTruth):
 
 
 # --- child processes -------------------------------------------------------------
-_libc = ctypes.CDLL(None, use_errno=True)
-_prctl = _libc.prctl
 _children = set()
 _children_lock = threading.Lock()
 
 
-def _die_with_parent():
-    # Runs in the child between fork and exec: if the test node is killed
-    # outright (SIGKILL at rostest's time limit), the kernel kills the child.
-    _prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
-
-
-class Child(object):
-    """A command run as the user would run it, in a process group of its own.
-
-    The environment is inherited (ROS_MASTER_URI comes from rostest). Output
-    goes to a log file whose tail `output()` returns for failure messages.
-    """
+class Child(Process):
+    """A command run as the user would run it: the harness's Process, its output
+    in a log file of its own, killed by the kernel should this test node be
+    killed outright (SIGKILL at rostest's time limit). The environment is
+    inherited (ROS_MASTER_URI comes from rostest)."""
 
     def __init__(self, args):
-        self.args = list(args)
-        self._log = tempfile.NamedTemporaryFile(prefix='tb3_child_', suffix='.log', delete=False)
-        self.popen = subprocess.Popen(self.args, stdin=subprocess.DEVNULL, stdout=self._log,
-                                      stderr=subprocess.STDOUT, process_group=0,
-                                      preexec_fn=_die_with_parent)
+        super(Child, self).__init__(os.path.basename(args[0]), args, die_with_parent=True)
         with _children_lock:
             _children.add(self)
 
-    @property
-    def pid(self):
-        return self.popen.pid
-
-    def running(self):
-        return self.popen.poll() is None
-
-    def signal_group(self, signum):
-        try:
-            os.killpg(self.popen.pid, signum)
-        except ProcessLookupError:
-            pass
-
-    def wait(self, timeout):
-        """Exit code, or None if still running after `timeout` wall seconds."""
-        try:
-            return self.popen.wait(timeout)
-        except subprocess.TimeoutExpired:
-            return None
-
-    def stop(self):
-        """SIGINT, then SIGTERM, then SIGKILL to the whole group, until it is gone."""
-        for signum, grace in ((signal.SIGINT, 5.0), (signal.SIGTERM, 3.0), (signal.SIGKILL, 3.0)):
-            if self.popen.poll() is not None:
-                break
-            self.signal_group(signum)
-            self.wait(grace)
-        # Anything the leader left behind in its group goes too.
-        self.signal_group(signal.SIGKILL)
-        self.popen.poll()
+    def stop(self, timeout=5.0):
+        code = super(Child, self).stop(timeout)
         with _children_lock:
             _children.discard(self)
-
-    def output(self, tail=3000):
-        try:
-            with open(self._log.name, 'rb') as log:
-                text = log.read().decode('utf-8', 'replace')
-        except OSError:
-            return ''
-        return text[-tail:]
-
-    def describe(self):
-        return '%s (exit %r), output:\n%s' % (' '.join(self.args), self.popen.poll(), self.output())
+        return code
 
 
 def stop_all_children():

@@ -2,7 +2,7 @@
 because they start and stop ROS masters themselves (pytest, inside
 `source setup.bash`: `python3 -m pytest -q test/system`).
 
-Every process is started by tools/demo.py's Process: a process group of its
+Every process is started by tb3_harness's Process: a process group of its
 own, output to a log file, stopped by group (SIGINT, then SIGTERM, then
 SIGKILL) in the fixtures' finalizers (conftest.py), also when a test fails.
 Every master listens on a free loopback port, never on 11311.
@@ -10,14 +10,9 @@ Every master listens on a free loopback port, never on 11311.
 import os
 import signal
 import subprocess
-import sys
 import time
-from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(REPO / 'tools'))
-
-import demo  # noqa: E402  (tools/demo.py: Process, free_port, start_master, run_script)
+from tb3_harness import processes as harness
 
 MASTER_TIMEOUT = 30.0   # wall s for a roscore to answer
 
@@ -28,11 +23,7 @@ def master_uri(port):
 
 def master_pid(port):
     """The master's pid, or None if nothing answers on `port`."""
-    import rosgraph
-    try:
-        return rosgraph.Master('/tb3_system_test', master_uri=master_uri(port)).getPid()
-    except Exception:  # refused, reset, timed out: not there
-        return None
+    return harness.master_pid(master_uri(port))
 
 
 def wait_until(predicate, timeout, poll=0.2):
@@ -52,8 +43,8 @@ class Processes(object):
         self.log_dir = str(log_dir)
         self.started = []
 
-    def start(self, name, argv):
-        process = demo.Process(name, list(argv), self.log_dir)
+    def start(self, name, argv, **popen):
+        process = harness.Process(name, list(argv), self.log_dir, **popen)
         self.started.append(process)
         return process
 
@@ -61,9 +52,9 @@ class Processes(object):
         master = self.start(name, ['roscore', '-p', str(port)])
         if not wait_until(lambda: master_pid(port) is not None or not master.running(), MASTER_TIMEOUT):
             raise AssertionError('roscore -p %d did not answer within %.0f s; %s:\n%s'
-                                 % (port, MASTER_TIMEOUT, master.log, demo.tail(master.log)))
+                                 % (port, MASTER_TIMEOUT, master.log, harness.tail(master.log)))
         if not master.running():
-            raise AssertionError('roscore -p %d exited; %s:\n%s' % (port, master.log, demo.tail(master.log)))
+            raise AssertionError('roscore -p %d exited; %s:\n%s' % (port, master.log, harness.tail(master.log)))
         return master
 
     def stop_all(self):

@@ -1,9 +1,9 @@
 """The tutorial's scripts end in the same place at real_time_factor 5 and 0 (as
 fast as possible) as at 1 (real time): within 1 cm and 1 degree.
 
-One roscore of this module's own (tools/demo.py's start_master, a free
+One roscore of this module's own (tb3_harness's start_master, a free
 loopback port) and this process as a rospy node (as `make demo` is); for each
-script and each factor, tools/demo.py's run_script: a fresh `roslaunch
+script and each factor, tb3_harness's run_script: a fresh `roslaunch
 tb3_sim_bringup tb3_empty_world.launch real_time_factor:=F paused:=true`,
 `rosrun tb3_sim_nav SCRIPT`, unpaused once the script has connected, the
 ground-truth pose recorded until after its exit, the simulator stopped. The
@@ -21,8 +21,8 @@ import sys
 
 import pytest
 
-from tb3_system_utils import demo
-import demo_report  # noqa: E402  (tools/, put on sys.path by tb3_system_utils)
+from tb3_harness import report, tutorial
+from tb3_harness.processes import start_master
 
 POSITION_TOLERANCE = 0.01   # m
 HEADING_TOLERANCE = 1.0     # deg
@@ -39,7 +39,7 @@ def demo_node(tmp_path_factory):
     log_dir = str(tmp_path_factory.mktemp('speed_agreement_logs'))
     master = None
     try:
-        master = demo.start_master(log_dir)
+        master = start_master(log_dir)
         import rospy
         rospy.init_node('tb3_speed_agreement', anonymous=True, argv=[sys.argv[0]], disable_signals=True)
         assert not rospy.rostime.is_wallclock(), 'the test node did not pick up /use_sim_time'
@@ -52,24 +52,24 @@ def demo_node(tmp_path_factory):
             master.stop()
 
 
-@pytest.mark.parametrize('script,expected', demo.SCRIPTS)
+@pytest.mark.parametrize('script,expected', tutorial.SCRIPTS)
 def test_script_ends_within_1cm_1deg_at_factors_5_and_0_of_factor_1(script, expected, demo_node, monkeypatch):
-    # run_script (tools/demo.py at 63270c4) counts a script's sim time from `rosrun`:
+    # run_script (tools/demo.py at 63270c4, now tb3_harness.tutorial) counts a script's sim time from `rosrun`:
     # at factor 0 the simulator runs free while python starts the script (1-2 wall s,
     # 40-80 sim s), which its limit of 4x the expected sim time did not allow for.
     # This test is about where the scripts end: a limit that cannot cut them short.
-    monkeypatch.setattr(demo, 'TIMEOUT_FACTOR', 10.0)
+    monkeypatch.setattr(tutorial, 'TIMEOUT_FACTOR', 10.0)
     ends, walls, behind = {}, {}, {}
     for factor in FACTORS:
         options = argparse.Namespace(real_time_factor=factor, profile=None, paused_start=True)
         log_dir = os.path.join(demo_node, 'factor_%g' % factor)
         os.makedirs(log_dir, exist_ok=True)
-        result, error = demo.run_script(script, expected, options, log_dir)
+        result, error = tutorial.run_script(script, expected, options, log_dir)
         # Steps lockstep did not wait for a node (logged once per 5 s at most).
         with open(os.path.join(log_dir, script[:-3] + '.sim.log')) as sim_log:
             behind[factor] = sum(1 for line in sim_log if 'lockstep:' in line)
         assert error is None, '%s at real_time_factor %g: %s' % (script, factor, error)
-        summary = demo_report.summarize(result)
+        summary = report.summarize(result)
         assert summary is not None, '%s at real_time_factor %g: no ground truth recorded' % (script, factor)
         ends[factor], walls[factor] = summary.end, (result.wall_time, result.sim_time)
     _, x1, y1, yaw1 = ends[1.0]
@@ -77,7 +77,7 @@ def test_script_ends_within_1cm_1deg_at_factors_5_and_0_of_factor_1(script, expe
     for factor in FACTORS[1:]:
         _, x, y, yaw = ends[factor]
         apart = math.hypot(x - x1, y - y1)
-        turned = abs(math.degrees(demo_report.normalize(yaw - yaw1)))
+        turned = abs(math.degrees(report.normalize(yaw - yaw1)))
         print('MEASURED speed_agreement %s factor %g: apart %.4f m, %.3f deg; ends factor 1 (%+.4f, %+.4f, '
               '%+.2f deg), factor %g (%+.4f, %+.4f, %+.2f deg); wall/sim s factor 1 %.1f/%.1f, factor %g %.1f/%.1f; '
               'lockstep left it behind factor 1 %d, factor %g %d times'

@@ -24,7 +24,7 @@ import time
 
 import pytest
 
-from tb3_system_utils import demo, run, wait_until
+from tb3_system_utils import harness, run, wait_until
 
 TELEOP = ['rosrun', 'tb3_sim_nav', 'tb3_teleop_key']
 LIMITS = {'burger': (0.22, 2.84), 'waffle': (0.26, 1.82), 'waffle_pi': (0.26, 1.82)}
@@ -41,8 +41,8 @@ REST_WITHIN = 10.0    # wall s for the robot to be at rest after the teleop exit
 TURN = 0.6            # rad the robot must turn left before its path is judged
 
 
-class PtyProcess(demo.Process):
-    """demo.Process (own process group, stopped by group) whose controlling
+class PtyProcess(harness.Process):
+    """harness.Process (own process group, stopped by group) whose controlling
     terminal is a new pty: the test types on the master side and reads there
     what the child prints (also written to the log file)."""
 
@@ -92,7 +92,7 @@ class PtyProcess(demo.Process):
         os.close(self.master)
         self.master = None
 
-    def stop(self, timeout=demo.STOP_TIMEOUT):
+    def stop(self, timeout=harness.STOP_TIMEOUT):
         code = super(PtyProcess, self).stop(timeout)
         if self.master is not None:
             self.hang_up()
@@ -188,7 +188,7 @@ def truth(master, processes):
     echo = Echo(processes, '/base_pose_ground_truth')
     ready = wait_until(lambda: poses(echo) or not sim.running(), SIM_READY)
     assert ready and sim.running(), 'no ground truth within %.0f s; %s:\n%s' % (
-        SIM_READY, sim.log, demo.tail(sim.log))
+        SIM_READY, sim.log, harness.tail(sim.log))
     return echo
 
 

@@ -19,6 +19,7 @@ import rosgraph.network
 CALLER_ID = '/tb3_bench_reader'
 CHUNK = 1 << 16
 CLOCK_RECORD = struct.Struct('<III')  # length (8), secs, nsecs
+LENGTH = struct.Struct('<I')
 
 
 class ReaderError(Exception):
@@ -39,11 +40,14 @@ def _request_topic(node_uri, topic):
 
 class TcprosReader(object):
     """Subscribes to `topic` of the node whose XML-RPC URI `lookup()` gives
-    (None while unknown); retries until it publishes or `timeout` wall s pass."""
+    (None while unknown); retries until it publishes or `timeout` wall s pass.
+    With `keep`, each whole message's serialised body goes to keep(body), in
+    the reader's thread (tests use it to see that none is lost)."""
 
-    def __init__(self, lookup, topic, timeout=60.0):
+    def __init__(self, lookup, topic, timeout=60.0, keep=None, caller_id=CALLER_ID):
         self.topic = topic
         self.clock = None  # newest /clock time (s), if topic is /clock
+        self._keep = keep
         deadline = time.monotonic() + timeout
         while True:
             address, why_not = _request_topic(lookup(), topic)
@@ -56,7 +60,7 @@ class TcprosReader(object):
         self._sock = socket.create_connection((host, port), timeout=timeout)
         # md5sum '*' accepts any type; no tcp_nodelay, as a default rospy subscriber asks.
         self._sock.sendall(rosgraph.network.encode_ros_handshake_header(
-            {'callerid': CALLER_ID, 'topic': topic, 'md5sum': '*', 'tcp_nodelay': '0'}))
+            {'callerid': caller_id, 'topic': topic, 'md5sum': '*', 'tcp_nodelay': '0'}))
         buffer = io.BytesIO()
         reply = rosgraph.network.read_ros_handshake_header(self._sock, buffer, CHUNK)
         if 'error' in reply:
@@ -75,13 +79,27 @@ class TcprosReader(object):
                 return
             if not chunk:
                 return
-            if self.topic == '/clock':
+            if self._keep is not None:
+                tail = self._split(tail + chunk)
+            elif self.topic == '/clock':
                 data = tail + chunk
                 whole = len(data) - len(data) % CLOCK_RECORD.size
                 if whole:
                     _, secs, nsecs = CLOCK_RECORD.unpack_from(data, whole - CLOCK_RECORD.size)
                     self.clock = secs + nsecs * 1e-9
                 tail = data[whole:]
+
+    def _split(self, data):
+        """Hands each whole message of `data` to keep(); what remains of a message begun."""
+        start = 0
+        while len(data) - start >= LENGTH.size:
+            (length,) = LENGTH.unpack_from(data, start)
+            end = start + LENGTH.size + length
+            if end > len(data):
+                break
+            self._keep(data[start + LENGTH.size:end])
+            start = end
+        return data[start:]
 
     def close(self):
         try:

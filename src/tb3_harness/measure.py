@@ -1,0 +1,45 @@
+"""Measurements of running processes, off /proc and the node's own XML-RPC API: for the bench, the soak and the tests."""
+import os
+import platform
+import xmlrpc.client
+
+
+def machine():
+    model = 'unknown CPU'
+    with open('/proc/cpuinfo') as cpuinfo:
+        for line in cpuinfo:
+            if line.startswith('model name'):
+                model = line.split(':', 1)[1].strip()
+                break
+    return '%s, %d cores, %s, Python %s' % (model, os.cpu_count(), platform.platform(terse=True),
+                                            platform.python_version())
+
+
+def sim_uri():
+    """XML-RPC URI of the /tb3_sim node, or None while it is not registered."""
+    import rosgraph
+    try:
+        return rosgraph.Master('/tb3_bench').lookupNode('/tb3_sim')
+    except rosgraph.MasterException:
+        return None
+
+
+def sim_pid():
+    """PID of the /tb3_sim node, from its own XML-RPC API."""
+    return xmlrpc.client.ServerProxy(sim_uri()).getPid('/tb3_bench')[2]
+
+
+def cpu_seconds(pid):
+    """User + system CPU time (s) of a process and its threads."""
+    with open('/proc/%d/stat' % pid) as stat:
+        fields = stat.read().rsplit(')', 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+def memory_mib(pid, field='VmHWM'):
+    """A memory figure of /proc/PID/status in MiB: VmHWM (peak RSS) or VmRSS (now)."""
+    with open('/proc/%d/status' % pid) as status:
+        for line in status:
+            if line.startswith(field + ':'):
+                return int(line.split()[1]) / 1024.0
+    return float('nan')
