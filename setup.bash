@@ -1,7 +1,8 @@
 # Source me (`source setup.bash`) for a shell where the tutorial's commands
 # work: the catkin workspace that `make setup` built, the project's venv
 # (Debian's /usr/bin/python3 plus pybullet) first on PATH whatever python
-# came first before, and ROS bound to this machine's loopback.
+# came first before, and ROS bound to this machine's loopback unless you
+# chose an address yourself (ROS_IP or ROS_HOSTNAME, for a second machine).
 _tb3_root="$(cd "$(dirname "${BASH_SOURCE[0]:-$0}")" && pwd)"
 if [ -f "$_tb3_root/.ws/devel/setup.bash" ]; then
   source "$_tb3_root/.ws/devel/setup.bash"
@@ -9,7 +10,8 @@ if [ -f "$_tb3_root/.ws/devel/setup.bash" ]; then
     *":$_tb3_root/.venv/bin:"*) ;;
     *) export PATH="$_tb3_root/.venv/bin:$PATH" ;;
   esac
-  export ROS_HOSTNAME="${ROS_HOSTNAME:-localhost}"
+  # ROS_HOSTNAME wins over ROS_IP: set it only if neither is set.
+  [ -n "${ROS_HOSTNAME:-}${ROS_IP:-}" ] || export ROS_HOSTNAME=localhost
   export ROS_MASTER_URI="${ROS_MASTER_URI:-http://localhost:11311}"
 else
   echo "tb3_sim_nav: run 'make setup' in $_tb3_root first" >&2
