@@ -26,6 +26,7 @@ import time
 from tb3_harness import report
 from tb3_harness.processes import RunError, say, start_master
 from tb3_harness.tutorial import LAUNCH, SCRIPTS, run_script
+from tb3_sim_nav.robot_model import TURTLEBOT3_MODELS
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 _T0 = time.monotonic()
@@ -41,6 +42,8 @@ def parse_args(argv):
                         help='launch arg real_time_factor (default 1.0; 0 = as fast as possible)')
     parser.add_argument('--profile', metavar='NAME',
                         help='launch arg profile (passed only if given)')
+    parser.add_argument('--model', choices=TURTLEBOT3_MODELS,
+                        help='launch arg model (default: $TURTLEBOT3_MODEL, else burger)')
     parser.add_argument('--output', default=os.path.join(ROOT, 'demo_output'), metavar='DIR',
                         help='folder for demo_paths.png, summary.txt and logs/ (default: %(default)s)')
     parser.add_argument('--scripts', nargs='+', choices=[name for name, _ in SCRIPTS], metavar='SCRIPT',
@@ -113,8 +116,9 @@ def main(argv=None):
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
     total = time.monotonic() - _T0
+    model = args.model or os.environ.get('TURTLEBOT3_MODEL', 'burger')
     if results:
-        header = ['tb3_sim_nav demo: the tutorial\'s scripts on the pybullet TurtleBot3 Burger',
+        header = ['tb3_sim_nav demo: the tutorial\'s scripts on the pybullet TurtleBot3 %s' % model,
                   'real_time_factor %g%s, total wall time %.1f s'
                   % (args.real_time_factor, ', profile %s' % args.profile if args.profile else '', total), '']
         lines = header
@@ -127,8 +131,8 @@ def main(argv=None):
             summary.write(text)
         picture = os.path.join(args.output, 'demo_paths.png')
         report.plot_paths(results, picture,
-                               'TurtleBot3 Burger in pybullet, real_time_factor %g%s' % (args.real_time_factor,
-                                                          ', profile %s' % args.profile if args.profile else ''))
+                          'TurtleBot3 %s in pybullet, real_time_factor %g%s' % (
+                              model, args.real_time_factor, ', profile %s' % args.profile if args.profile else ''))
         say('wrote %s and %s (process logs in %s)' % (picture, summary_file, log_dir))
     if failures:
         print('\ndemo FAILED:\n  ' + '\n  '.join(failure.replace('\n', '\n    ') for failure in failures),

@@ -16,10 +16,8 @@ def main():
     print('| parameter | default | unit | meaning |')
     print('|---|---|---|---|')
     for parameter in PARAMETERS:
-        if parameter.name == 'urdf_file':
-            default = '(set by the launch)'
-        elif parameter.origin == FROM_MODEL:
-            default = "the model's (its URDF's `<drive_limits>`)"
+        if parameter.origin == FROM_MODEL:
+            default = "the model's"
         elif parameter.origin == FROM_PROFILE:
             default = ', '.join('%s: %s' % (profile, shown(PROFILES[profile][parameter.name]))
                                 for profile in sorted(PROFILES))

@@ -139,6 +139,8 @@ def run_script(script, expected, args, log_dir):
     launch_argv = ['roslaunch', '--wait'] + list(LAUNCH) + ['real_time_factor:=%g' % args.real_time_factor]
     if args.profile is not None:
         launch_argv.append('profile:=%s' % args.profile)
+    if getattr(args, 'model', None) is not None:
+        launch_argv.append('model:=%s' % args.model)
     if paused_start:
         launch_argv.append('paused:=true')
     sim = script_process = recorder = start_index = None

@@ -10,10 +10,10 @@ limits default to the robot model's own (its URDF's <drive_limits>).
 """
 import dataclasses
 import math
-import os
 from collections import namedtuple
 from typing import Optional
 
+from .robot_model import model_problem
 from .world_file import WorldError, parse_robots
 
 Parameter = namedtuple('Parameter', 'name default kind check unit doc origin')
@@ -58,6 +58,16 @@ def _at_least(minimum):
     return check
 
 
+def _between(low, high, unit=''):
+    def check(value):
+        return None if low <= value <= high else 'must be between %s and %s%s' % (low, high, unit)
+    return check
+
+
+def _model(value):
+    return model_problem(value)
+
+
 def _robots(value):
     try:
         parse_robots(value, 'the list')
@@ -90,8 +100,8 @@ def _p(default, doc, check=None, unit='', origin=None):
 @dataclasses.dataclass(frozen=True)
 class Config(object):
     """Every parameter of the simulator node, resolved and checked."""
-    urdf_file: str = _p('', 'URDF of the robot (when ~robots is empty), loaded into pybullet; wheel geometry and limits come from it')
-    robots: tuple = _p((), 'robots with namespaces, instead of the one robot of ~urdf_file: a list of {name, model, position: [x, y(, z)], yaw} as in world files', _robots)
+    model: str = _p('burger', 'the robot (when ~robots is empty): burger, waffle, waffle_pi or the path of a URDF; its geometry, limits and cameras come from its URDF', _model)
+    robots: tuple = _p((), 'robots with namespaces, instead of the one robot of ~model: a list of {name, model, position: [x, y(, z)], yaw} as in world files', _robots)
     world: str = _p('empty', 'world by name (worlds/NAME.yaml) or path to a world file')
     x_pos: float = _p(0.0, 'spawn position x', unit='m')
     y_pos: float = _p(0.0, 'spawn position y', unit='m')
@@ -106,8 +116,8 @@ class Config(object):
     startup_hold: float = _p(0.3, 'sim time holds this long when a node subscribes to /clock, so it can connect first', _non_negative, 's (wall)')
     odom_rate: float = _p(30.0, 'rate of odom, tf and base_pose_ground_truth (sim time)', _positive, 'Hz')
     joint_states_rate: float = _p(30.0, 'rate of joint_states (sim time)', _positive, 'Hz')
-    max_linear_speed: Optional[float] = _p(None, 'commands beyond this are clamped', _positive, 'm/s', FROM_MODEL)
-    max_angular_speed: Optional[float] = _p(None, 'commands beyond this are clamped', _positive, 'rad/s', FROM_MODEL)
+    max_linear_speed: Optional[float] = _p(None, "commands beyond this are clamped; unset: the model's, from its URDF's <drive_limits> (burger 0.22, waffle and waffle_pi 0.26)", _positive, 'm/s', FROM_MODEL)
+    max_angular_speed: Optional[float] = _p(None, "the same for turning (burger 2.84, waffle and waffle_pi 1.82)", _positive, 'rad/s', FROM_MODEL)
     wheel_torque: float = _p(1.5, 'stall torque of each wheel motor (Dynamixel XL430 at 12 V)', _positive, 'N m')
     wheel_acceleration: float = _p(1.0, "limit on each wheel rim's acceleration, as TurtleBot3's Gazebo set-up (wheelAcceleration 1); 0 = none", _non_negative, 'm/s^2')
     odom_frame: str = _p('odom', 'frame of odom and of its tf parent (a robot with a name gets it as a prefix: tb3_0/odom)', _frame_id)
@@ -121,6 +131,10 @@ class Config(object):
     scan_noise: float = _p(0.01, 'standard deviation of Gaussian range noise; 0 = none', _non_negative, 'm')
     imu: bool = _p(True, 'publish the IMU on imu')
     imu_rate: float = _p(100.0, 'IMU rate (sim time); at most ~physics_rate: the real Burger and its Gazebo model give 200 Hz, with ~physics_rate 200', _positive, 'Hz')
+    camera_width: Optional[int] = _p(None, 'image width of the Waffle (Pi) camera; unset: the model\'s, at most 640 (the height follows the model\'s aspect)', _between(1, 4096), 'pixels', FROM_MODEL)
+    camera_height: Optional[int] = _p(None, 'image height (unset: from the width and the model\'s aspect)', _between(1, 4096), 'pixels', FROM_MODEL)
+    camera_horizontal_fov: Optional[float] = _p(None, "horizontal field of view; unset: the model's (waffle 1.3439, waffle_pi 1.085595)", _between(0.1, 3.0, ' rad'), 'rad', FROM_MODEL)
+    camera_rate: Optional[float] = _p(None, "camera rate (sim time), at most ~physics_rate; unset: the model's (30)", _positive, 'Hz', FROM_MODEL)
     seed: int = _p(-1, 'seed of every noise source; -1 = different each run', _at_least(-1))
     profile: str = _p('gazebo', 'realism profile: chooses the defaults below', _one_of(*sorted(PROFILES)))
     odom_source: str = _p(None, 'odom from the true pose (Gazebo) or integrated from wheel encoders (firmware)', _one_of('world', 'encoders'), origin=FROM_PROFILE)
@@ -141,7 +155,7 @@ class Config(object):
 
 
 def _kind(field):
-    return float if field.type == Optional[float] else field.type
+    return dict(((Optional[float], float), (Optional[int], int))).get(field.type, field.type)
 
 
 #: The parameters in the node's order, for the README table and the tests.
@@ -180,10 +194,8 @@ def resolve(lookup, parameters=PARAMETERS):
         if problem:
             raise ParameterError('parameter ~%s = %r: %s' % (parameter.name, value, problem))
         resolved[parameter.name] = value
-    if not resolved['robots'] and not os.path.isfile(resolved['urdf_file']):
-        raise ParameterError('parameter ~urdf_file = %r: no such file' % resolved['urdf_file'])
-    for rate in ('odom_rate', 'joint_states_rate', 'scan_rate', 'imu_rate'):
-        if resolved[rate] > resolved['physics_rate']:
+    for rate in ('odom_rate', 'joint_states_rate', 'scan_rate', 'imu_rate', 'camera_rate'):
+        if resolved[rate] is not None and resolved[rate] > resolved['physics_rate']:
             raise ParameterError('parameter ~%s = %r: must not exceed ~physics_rate = %r'
                                  % (rate, resolved[rate], resolved['physics_rate']))
     if resolved['scan_range_min'] >= resolved['scan_range_max']:

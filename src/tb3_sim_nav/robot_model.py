@@ -1,9 +1,12 @@
-"""A robot model read from its URDF: drive geometry, limits, casters. The one source of truth.
+"""A robot model read from its URDF: drive geometry, limits, casters, cameras. The one source of truth.
 
 The simulator knows a TurtleBot3 only through its URDF: the wheels' radius
 and separation from the wheel joints and links, the drive's limits from the
 element <drive_limits max_linear_speed=".." max_angular_speed=".."/>, the
-ball casters from their link names.
+ball casters from their link names, and its cameras from the same
+<gazebo reference="LINK"><sensor type="camera"|"depth"> blocks that
+ROBOTIS' Gazebo descriptions give (size, field of view, clip, rate, topics,
+frame).
 """
 import os
 import xml.etree.ElementTree as ElementTree
@@ -22,8 +25,15 @@ ROOT_INERTIAL = ('<inertial><origin xyz="0 0 0" rpy="0 0 0"/><mass value="0.001"
 
 DriveGeometry = namedtuple('DriveGeometry', 'wheel_radius wheel_separation')
 
+#: A camera as a Gazebo sensor block describes it. `depth`: a depth camera
+#: (RealSense R200: colour, depth image and cloud from one sensor); topics are
+#: relative to the robot's namespace (camera/rgb/image_raw...); `cutoff`: depths
+#: closer than this read NaN (Gazebo's pointCloudCutoff).
+CameraSpec = namedtuple('CameraSpec', 'link name depth width height horizontal_fov near far rate frame '
+                                      'image_topic info_topic depth_topic depth_info_topic points_topic cutoff')
+
 #: Everything the simulator takes from a robot's URDF.
-RobotModel = namedtuple('RobotModel', 'urdf_file name geometry limits casters')
+RobotModel = namedtuple('RobotModel', 'urdf_file name geometry limits casters cameras')
 
 
 class ModelError(ValueError):
@@ -114,6 +124,56 @@ def _limits(robot, urdf_path):
     return Limits(*values)
 
 
+def _camera(gazebo, sensor, urdf_path):
+    """A CameraSpec of a <gazebo reference=LINK><sensor> block, or ModelError."""
+    def text(element, path, default=None):
+        found = element.find(path)
+        if found is None or found.text is None:
+            if default is None:
+                raise ModelError('URDF file %r: camera %r has no <%s>' % (urdf_path, sensor.get('name'), path))
+            return default
+        return found.text.strip()
+
+    def number(element, path, default=None):
+        value = text(element, path, default)
+        try:
+            return float(value)
+        except ValueError:
+            raise ModelError('URDF file %r: camera %r: <%s> %r is not a number'
+                             % (urdf_path, sensor.get('name'), path, value))
+    plugin = sensor.find('plugin')
+    if plugin is None:
+        raise ModelError('URDF file %r: camera %r has no <plugin>' % (urdf_path, sensor.get('name')))
+    camera = text(plugin, 'cameraName', 'camera')
+
+    def topic(name, default):
+        return camera + '/' + text(plugin, name, default)
+    return CameraSpec(
+        link=gazebo.get('reference'), name=sensor.get('name', 'camera'), depth=sensor.get('type') == 'depth',
+        width=int(number(sensor, 'camera/image/width')), height=int(number(sensor, 'camera/image/height')),
+        horizontal_fov=number(sensor, 'camera/horizontal_fov'), near=number(sensor, 'camera/clip/near'),
+        far=number(sensor, 'camera/clip/far'), rate=number(plugin, 'updateRate'),
+        frame=text(plugin, 'frameName'), image_topic=topic('imageTopicName', 'rgb/image_raw'),
+        info_topic=topic('cameraInfoTopicName', 'rgb/camera_info'),
+        depth_topic=topic('depthImageTopicName', 'depth/image_raw'),
+        depth_info_topic=topic('depthImageCameraInfoTopicName', 'depth/camera_info'),
+        points_topic=topic('pointCloudTopicName', 'depth/points'),
+        cutoff=number(plugin, 'pointCloudCutoff', '0'))
+
+
+def _cameras(robot, urdf_path):
+    links = set(link.get('name') for link in robot.iter('link'))
+    cameras = []
+    for gazebo in robot.findall('gazebo'):
+        for sensor in gazebo.findall('sensor'):
+            if sensor.get('type') in ('camera', 'depth'):
+                if gazebo.get('reference') not in links:
+                    raise ModelError('URDF file %r: camera %r refers to no link of the file: %r'
+                                     % (urdf_path, sensor.get('name'), gazebo.get('reference')))
+                cameras.append(_camera(gazebo, sensor, urdf_path))
+    return tuple(cameras)
+
+
 def load_model(urdf_path):
     """The RobotModel of a URDF file, or ModelError naming the file and what it lacks."""
     robot = _parse(urdf_path)
@@ -121,18 +181,31 @@ def load_model(urdf_path):
                            if link.get('name', '').startswith(CASTER_PREFIX)))
     return RobotModel(urdf_file=urdf_path, name=robot.get('name', ''),
                       geometry=_drive_geometry(robot, urdf_path), limits=_limits(robot, urdf_path),
-                      casters=casters)
+                      casters=casters, cameras=_cameras(robot, urdf_path))
 
 
 #: The TurtleBot3 family, as TURTLEBOT3_MODEL names it.
 TURTLEBOT3_MODELS = ('burger', 'waffle', 'waffle_pi')
 
 
+def _is_path(model):
+    return os.sep in model or model.endswith('.urdf')
+
+
+def model_problem(model):
+    """Why `model` is neither a TurtleBot3 model nor the path of a URDF file; None if it is one."""
+    if _is_path(model):
+        return None if os.path.isfile(os.path.expanduser(model)) else 'no such URDF file'
+    if model not in TURTLEBOT3_MODELS:
+        return 'unknown TurtleBot3 model: the models are %s (or give the path of a URDF)' % ', '.join(TURTLEBOT3_MODELS)
+    return None
+
+
 def model_urdf(model, urdf_folder):
     """The URDF file of a model given by TurtleBot3 name (in `urdf_folder`) or by path."""
-    if os.sep in model or model.endswith('.urdf'):
+    problem = model_problem(model)
+    if problem:
+        raise ModelError('model %r: %s' % (model, problem))
+    if _is_path(model):
         return os.path.abspath(os.path.expanduser(model))
-    if model not in TURTLEBOT3_MODELS:
-        raise ModelError('unknown TurtleBot3 model %r: the models are %s (or give the path of a URDF)'
-                         % (model, ', '.join(TURTLEBOT3_MODELS)))
     return os.path.join(urdf_folder, 'turtlebot3_%s.urdf' % model)

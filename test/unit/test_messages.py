@@ -68,7 +68,7 @@ def test_imu_covariances_follow_the_noise_with_a_floor():
 def test_the_robots_are_the_tutorials_one_or_those_listed_then_the_worlds(burger_urdf):
     listed = [dict(name='tb3_0', model='burger', position=[1, 2], yaw=0.5)]
     world = WorldSpec([], [RobotSpec('guest', 'waffle', (3.0, 3.0, 0.0), 0.0)])
-    single = resolve(lambda name, default: dict(urdf_file=str(burger_urdf), x_pos=-2.0).get(name, default))
+    single = resolve(lambda name, default: dict(model=str(burger_urdf), x_pos=-2.0).get(name, default))
     multi = resolve(lambda name, default: dict(robots=listed).get(name, default))
     assert robot_specs(single, world) == [RobotSpec('', str(burger_urdf), (-2.0, 0.0, 0.0), 0.0), world.robots[0]]
     assert robot_specs(multi, world) == [RobotSpec('tb3_0', 'burger', (1.0, 2.0, 0.0), 0.5), world.robots[0]]

@@ -11,7 +11,7 @@ from tb3_sim_nav.params import FROM_MODEL, FROM_PROFILE, PROFILES, PARAMETERS, P
 def resolve_with(burger_urdf):
     """resolve() with a dict standing in for rospy.get_param('~name', default)."""
     def run(**given):
-        values = dict(urdf_file=str(burger_urdf))
+        values = dict(model=str(burger_urdf))
         values.update(given)
         return resolve(lambda name, default: values.get(name, default))
     return run
@@ -25,7 +25,7 @@ def test_defaults_resolve(resolve_with, burger_urdf):
         if parameter.origin == FROM_MODEL:  # the robot model's own (its URDF's drive_limits)
             assert value is None
             continue
-        if parameter.name == 'urdf_file':
+        if parameter.name == 'model':
             expected = str(burger_urdf)
         elif parameter.origin == FROM_PROFILE:  # a realism knob: the gazebo profile's default
             expected = PROFILES['gazebo'][parameter.name]
@@ -53,7 +53,7 @@ def test_ints_are_accepted_for_floats(resolve_with):
     ('yaw', True, 'True'),
     ('physics_rate', False, 'False'),
     ('odom_frame', 5, '5'),
-    ('urdf_file', None, 'None'),
+    ('model', None, 'None'),
     # non-finite floats
     ('x_pos', math.nan, 'nan'),
     ('max_linear_speed', math.inf, 'inf'),
@@ -121,13 +121,18 @@ def test_bad_sensor_and_realism_values_name_the_parameter(resolve_with, name, va
     assert '~' + name in str(error.value) and repr(value) in str(error.value)
 
 
-@pytest.mark.parametrize('path', ['', 'no/such/robot.urdf'])
-def test_missing_urdf_file_raises_error_naming_it(resolve_with, path):
+@pytest.mark.parametrize('model', ['', 'no/such/robot.urdf', 'wafle'])
+def test_a_bad_model_raises_an_error_naming_it(resolve_with, model):
     with pytest.raises(ParameterError) as error:
-        resolve_with(urdf_file=path)
-    assert '~urdf_file' in str(error.value) and repr(path) in str(error.value)
+        resolve_with(model=model)
+    assert '~model' in str(error.value) and repr(model) in str(error.value)
 
 
-def test_urdf_file_not_given_at_all_raises():
-    with pytest.raises(ParameterError, match='~urdf_file'):
-        resolve(lambda name, default: default)
+def test_an_unknown_model_is_refused_naming_the_three():
+    with pytest.raises(ParameterError, match="~model = 'wafle': unknown TurtleBot3 model: the models are burger, "
+                                             "waffle, waffle_pi"):
+        resolve(lambda name, default: dict(model='wafle').get(name, default))
+
+
+def test_the_model_defaults_to_the_burger():
+    assert resolve(lambda name, default: default).model == 'burger'

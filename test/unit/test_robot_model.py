@@ -175,9 +175,12 @@ def test_bad_drive_limits_are_refused(tmp_path, attributes):
 
 def test_models_by_name_are_urdfs_of_the_folder_and_paths_are_paths(tmp_path):
     assert model_urdf('waffle_pi', '/pkg/urdf') == '/pkg/urdf/turtlebot3_waffle_pi.urdf'
-    assert model_urdf(str(tmp_path / 'mine.urdf'), '/pkg/urdf') == str(tmp_path / 'mine.urdf')
+    mine = write(tmp_path, two_wheels(), name='mine.urdf')
+    assert model_urdf(str(mine), '/pkg/urdf') == str(mine)
+    with pytest.raises(ModelError, match="model '.*/gone.urdf': no such URDF file"):
+        model_urdf(str(tmp_path / 'gone.urdf'), '/pkg/urdf')
 
 
 def test_an_unknown_model_is_refused_naming_the_three(tmp_path):
-    with pytest.raises(ModelError, match="unknown TurtleBot3 model 'wafle': the models are burger, waffle, waffle_pi"):
+    with pytest.raises(ModelError, match="model 'wafle': unknown TurtleBot3 model: the models are burger, waffle, waffle_pi"):
         model_urdf('wafle', '/pkg/urdf')

@@ -66,7 +66,7 @@ def make_sim(burger_urdf):
     def make(obstacles=(), **overrides):
         # resolve() ignores names it does not know: a renamed parameter must fail here.
         assert set(overrides) <= {parameter.name for parameter in PARAMETERS}, overrides
-        overrides.setdefault('urdf_file', str(burger_urdf))
+        overrides.setdefault('model', str(burger_urdf))
         config = resolve(lambda name, default: overrides.get(name, default))
         sim = build(config, obstacles, [('', model, (config.x_pos, config.y_pos, config.z_pos, config.yaw))])
         sims.append(sim)

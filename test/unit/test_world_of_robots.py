@@ -24,7 +24,7 @@ def make(burger_urdf):
     made = []
 
     def make_simulation(robots, **parameters):
-        parameters.setdefault('urdf_file', str(burger_urdf))
+        parameters.setdefault('model', str(burger_urdf))
         parameters.setdefault('scan_noise', 0.0)
         config = resolve(lambda name, default: parameters.get(name, default))
         simulation = build(config, (), [(name, model, (x, y, 0.0, yaw)) for name, (x, y, yaw) in robots])

@@ -164,13 +164,15 @@ class SimulatorNode(object):
             now_s = now_ns * 1e-9
             for io in robots:
                 published = io.publish_imu(stamp, now_s) or published
+        for io in robots:
+            published = io.publish_cameras(now_ns, stamp) or published
         return published
 
 
 def robot_specs(config, world):
-    """The robots to spawn: those of ~robots, or else the one of ~urdf_file
+    """The robots to spawn: those of ~robots, or else the one of ~model
     without a name (the tutorial's), and then the world file's."""
-    own = list(config.robots) or [RobotSpec('', config.urdf_file, (config.x_pos, config.y_pos, config.z_pos),
+    own = list(config.robots) or [RobotSpec('', config.model, (config.x_pos, config.y_pos, config.z_pos),
                                             config.yaw)]
     return own + list(world.robots)
 
@@ -200,6 +202,9 @@ def _start_up():
                           config.max_linear_speed or model.limits.max_linear,
                           config.max_angular_speed or model.limits.max_angular, *(spec.position + (spec.yaw,)))
         rospy.loginfo('tb3_sim: world %r with %d obstacles', config.world, len(world.obstacles))
+        if 'TURTLEBOT3_MODEL' not in os.environ:
+            rospy.loginfo('tb3_sim: TURTLEBOT3_MODEL is not set: the launch gave model %s (burger unless model:= '
+                          'says otherwise; export TURTLEBOT3_MODEL=burger, waffle or waffle_pi to choose)', config.model)
         return config, build(config, world.obstacles, robots)
     except (params.ParameterError, ModelError, WorldError, ValueError) as error:
         rospy.logfatal('tb3_sim cannot start: %s', error)
