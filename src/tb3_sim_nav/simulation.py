@@ -13,10 +13,11 @@ from .world import World
 class Simulation(object):
     """Physics steps of `1 / physics_rate` s; time is an integer count of steps."""
 
-    def __init__(self, config, obstacles=(), world_class=World):
+    def __init__(self, config, obstacles=(), world_class=World, cameras=False):
+        """`cameras`: some robot will render images (the world then loads a faster renderer)."""
         self.config = config
         self.step_ns = int(round(1e9 / config.physics_rate))
-        self.world = world_class(self.step_ns * 1e-9, obstacles, gui=config.gui)
+        self.world = world_class(self.step_ns * 1e-9, obstacles, gui=config.gui, cameras=cameras)
         # One seed gives every robot's noise a stream of its own.
         self._seeds = np.random.SeedSequence(None if config.seed < 0 else config.seed)
         self.robots = {}  # name -> Robot, in the order they came
@@ -69,7 +70,7 @@ class Simulation(object):
 def build(config, obstacles, robots, world_class=World):
     """A Simulation with `robots`, a list of (name, model, pose), or the error of
     the first that cannot be placed, with nothing left open."""
-    simulation = Simulation(config, obstacles, world_class)
+    simulation = Simulation(config, obstacles, world_class, cameras=any(model.cameras for _, model, _ in robots))
     try:
         for name, model, pose in robots:
             simulation.add_robot(name, model, pose)

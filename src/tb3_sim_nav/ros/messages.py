@@ -3,9 +3,10 @@
 Each message is made once per robot and reused: a publication changes only
 its stamp and values.
 """
+import numpy as np
 from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import Imu, JointState, LaserScan
+from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan, PointCloud2, PointField
 
 from ..robot_model import LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT
 
@@ -100,3 +101,52 @@ def fill_imu(message, stamp, reading):
     _set_quaternion(message.orientation, reading.orientation)
     _set_xyz(message.angular_velocity, reading.angular_velocity)
     _set_xyz(message.linear_acceleration, reading.linear_acceleration)
+
+
+#: Bytes per pixel of the image encodings the cameras publish.
+ENCODINGS = {'rgb8': 3, '32FC1': 4}
+#: A point of the depth cloud: x, y, z (m, optical frame) and its colour packed in a float32, as PCL's rgb.
+POINT = np.dtype([('x', '<f4'), ('y', '<f4'), ('z', '<f4'), ('rgb', '<f4')])
+
+
+def image(frame, width, height, encoding):
+    message = Image(height=height, width=width, encoding=encoding, is_bigendian=0,
+                    step=width * ENCODINGS[encoding])
+    message.header.frame_id = frame
+    return message
+
+
+def fill_image(message, stamp, pixels):
+    """`pixels`: H x W x 3 uint8 (rgb8) or H x W float32 (32FC1, metres)."""
+    message.header.stamp = stamp
+    message.data = pixels.astype(pixels.dtype.newbyteorder('<'), copy=False).tobytes()
+
+
+def camera_info(frame, camera):
+    """The CameraInfo of a camera.Camera: K from its size and field of view, no distortion."""
+    fx, _, cx, _, fy, cy, _, _, _ = camera.intrinsics()
+    message = CameraInfo(width=camera.width, height=camera.height, distortion_model='plumb_bob',
+                         D=[0.0] * 5, K=list(camera.intrinsics()), R=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                         P=[fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0])
+    message.header.frame_id = frame
+    return message
+
+
+def points(frame, width, height):
+    """An organised PointCloud2 of x, y, z and rgb, H x W points, NaN where there is no depth."""
+    fields = [PointField(name=name, offset=POINT.fields[name][1], datatype=PointField.FLOAT32, count=1)
+              for name in POINT.names]
+    message = PointCloud2(height=height, width=width, fields=fields, is_bigendian=False,
+                          point_step=POINT.itemsize, row_step=POINT.itemsize * width, is_dense=False)
+    message.header.frame_id = frame
+    return message
+
+
+def fill_points(message, stamp, xyz, rgb):
+    """`xyz`: H x W x 3 float32, `rgb`: H x W x 3 uint8."""
+    cloud = np.empty(xyz.shape[:2], dtype=POINT)
+    cloud['x'], cloud['y'], cloud['z'] = xyz[..., 0], xyz[..., 1], xyz[..., 2]
+    packed = (rgb[..., 0].astype(np.uint32) << 16) | (rgb[..., 1].astype(np.uint32) << 8) | rgb[..., 2]
+    cloud['rgb'] = packed.view(np.float32)
+    message.header.stamp = stamp
+    message.data = cloud.tobytes()

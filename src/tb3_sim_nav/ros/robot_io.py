@@ -8,9 +8,10 @@ base_footprint.
 import rospy
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import Imu, JointState, LaserScan
+from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan, PointCloud2
 
 from ..diff_drive import sanitize_twist
+from ..pacing import Schedule
 from ..robot import LIDAR_LINK
 from . import messages
 
@@ -42,6 +43,7 @@ class RobotIO(object):
         if robot.imu:
             self.imu = messages.imu(prefix + IMU_LINK, config.imu_gyro_noise, config.imu_accel_noise)
             self.imu_pub = publishers.advertise(prefix + 'imu', Imu)
+        self.cameras = [CameraIO(camera, prefix, publishers) for camera in robot.cameras]
         self.cmd_vel = rospy.Subscriber(prefix + 'cmd_vel', Twist, self._on_cmd_vel, queue_size=10,
                                         tcp_nodelay=True)
 
@@ -96,7 +98,72 @@ class RobotIO(object):
         self.imu_pub.publish(self.imu)
         return True
 
+    def publish_cameras(self, now_ns, stamp):
+        published = False
+        for camera in self.cameras:
+            published = camera.publish(now_ns, stamp) or published
+        return published
+
     def close(self):
         for topic in (self.odom_pub, self.truth_pub, self.joints_pub, self.scan_pub, self.imu_pub, self.cmd_vel):
             if topic is not None:
                 topic.unregister()
+        for camera in self.cameras:
+            camera.close()
+
+
+def _subscribed(publisher):
+    return publisher is not None and publisher.get_num_connections() > 0
+
+
+class CameraIO(object):
+    """One camera's topics, as Gazebo's camera plugins name them: the colour
+    image and its camera_info; a depth camera's depth image, its camera_info
+    and its cloud too. Rendered only while someone subscribes to an image."""
+
+    def __init__(self, camera, prefix, publishers):
+        spec = camera.spec
+        frame = prefix + spec.frame
+        self.camera = camera
+        self._due = Schedule(round(1e9 / camera.rate))
+        self.image = messages.image(frame, camera.width, camera.height, 'rgb8')
+        self.info = messages.camera_info(frame, camera)
+        self.image_pub = publishers.advertise(prefix + spec.image_topic, Image)
+        self.info_pubs = [publishers.advertise(prefix + spec.info_topic, CameraInfo)]
+        self.depth_pub = self.points_pub = None
+        if spec.depth:
+            self.depth = messages.image(frame, camera.width, camera.height, '32FC1')
+            self.points = messages.points(frame, camera.width, camera.height)
+            self.depth_pub = publishers.advertise(prefix + spec.depth_topic, Image)
+            self.points_pub = publishers.advertise(prefix + spec.points_topic, PointCloud2)
+            self.info_pubs.append(publishers.advertise(prefix + spec.depth_info_topic, CameraInfo))
+
+    def publish(self, now_ns, stamp):
+        """Publishes what is due and wanted at `now_ns`; False if nothing was."""
+        if not self._due.due(now_ns):
+            return False
+        wanted = [publisher for publisher in [self.image_pub, self.depth_pub, self.points_pub] + self.info_pubs
+                  if _subscribed(publisher)]
+        if not wanted:
+            return False
+        if set(wanted) & {self.image_pub, self.depth_pub, self.points_pub}:
+            rgb, depth = self.camera.render()
+            if self.image_pub in wanted:
+                messages.fill_image(self.image, stamp, rgb)
+                self.image_pub.publish(self.image)
+            if self.depth_pub in wanted:
+                messages.fill_image(self.depth, stamp, depth)
+                self.depth_pub.publish(self.depth)
+            if self.points_pub in wanted:
+                messages.fill_points(self.points, stamp, self.camera.points(depth), rgb)
+                self.points_pub.publish(self.points)
+        self.info.header.stamp = stamp
+        for publisher in self.info_pubs:
+            if publisher in wanted:
+                publisher.publish(self.info)
+        return True
+
+    def close(self):
+        for publisher in [self.image_pub, self.depth_pub, self.points_pub] + self.info_pubs:
+            if publisher is not None:
+                publisher.unregister()
