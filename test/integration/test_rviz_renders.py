@@ -13,8 +13,8 @@ scan, then checks one screenshot after a settling time:
 - no display is in Error or Warn state (see ERROR_COLOURS for how);
 - driving the tutorial's circle adds red /odom arrows to the trail.
 
-Screenshots: `import -window root -depth 8 ppm:-` (imagemagick, a listed apt
-package), decoded with numpy, so no imaging library is needed; the last run's
+Screenshots: tb3_harness.screen (imagemagick's import, decoded with numpy,
+so no imaging library is needed); the last run's
 are kept in ~/.ros/test_results/tb3_sim_nav/rviz_renders/. rviz and Xvfb are
 stopped by process group (their PIDs) as soon as the screenshots are taken,
 in a `finally` (so also on failure), at rospy shutdown and at exit;
@@ -22,11 +22,12 @@ PR_SET_PDEATHSIG kills them if this node is killed outright.
 
 Parameter ~rviz_config: the configuration under test (default: the
 tutorial's demo.rviz); `rostest tb3_sim_nav rviz_renders.test
-rviz_config:=/path/to/other.rviz` shows that a broken one fails.
+rviz_config:=/path/to/other.rviz` shows that a broken one fails. With
+~camera true (rviz_camera.test: a Waffle Pi and camera.rviz) the camera's
+image must also be shown beside the 3D view: its Image panel, in the left
+dock, holds the pillars' green, which nothing else in the dock is.
 """
 import os
-import re
-import subprocess
 import time
 import unittest
 
@@ -36,10 +37,10 @@ import rospy
 import rostest
 import yaml
 from geometry_msgs.msg import Twist
+from tb3_harness.screen import green_pixels, save_png, screenshot, start_xvfb
 
 from tb3_test_utils import Child, init_test_node, report, wait_for
 
-SCREEN = (1280, 800)
 RENDER_TIMEOUT = 90.0     # wall s from rviz's start to a 3D view with robot and scan
 SETTLE = 3.0              # wall s after that for transient start-up statuses to clear
 DRIVE_SECONDS = 6.0       # wall s of the tutorial's circle command
@@ -49,6 +50,7 @@ MIN_ROBOT_PIXELS = 40     # orange pixels of the lidar (about 200 at the spawn p
 MIN_SCAN_PIXELS = 1000    # scan-coloured pixels (several thousand in the arena)
 MIN_NEW_TRAIL_PIXELS = 100  # red arrow pixels added by DRIVE_SECONDS of driving
 MIN_NAME_PIXELS = 100     # display names in rviz's "enabled, OK" blue: the panel is there
+MIN_CAMERA_GREEN = 300    # pillar-green pixels of the camera image in the left dock (thousands with a Waffle Pi)
 COLOUR_TOLERANCE = 12     # per channel, for the exact colours below
 
 # How "no display shows an error" is checked. rviz reports a display's status
@@ -71,31 +73,6 @@ CIRCLE.linear.x, CIRCLE.angular.z = 0.1, -0.5
 
 
 # --- screenshots -------------------------------------------------------------
-def read_ppm(data):
-    """A binary PPM (P6, maxval 255) as an H x W x 3 int array."""
-    fields, position = [], 0
-    while len(fields) < 4:
-        match = re.compile(rb'\s*(#[^\n]*\n\s*)*(\S+)').match(data, position)
-        fields.append(match.group(2))
-        position = match.end()
-    if fields[0] != b'P6' or int(fields[3]) != 255:
-        raise ValueError('not an 8-bit binary PPM: %r' % fields)
-    width, height = int(fields[1]), int(fields[2])
-    pixels = numpy.frombuffer(data, numpy.uint8, width * height * 3, position + 1)
-    return pixels.reshape(height, width, 3).astype(int)
-
-
-def screenshot(display):
-    data = subprocess.run(['import', '-display', display, '-window', 'root', '-depth', '8', 'ppm:-'],
-                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=30, check=True).stdout
-    return read_ppm(data)
-
-
-def save_png(image, path):
-    subprocess.run(['convert', 'ppm:-', path], input=b'P6 %d %d 255\n' % image.shape[1::-1]
-                   + image.astype(numpy.uint8).tobytes(), check=True, timeout=30)
-
-
 def near(image, colour, tolerance=COLOUR_TOLERANCE):
     """Boolean mask of the pixels within `tolerance` of `colour` on every channel."""
     return (numpy.abs(image - numpy.array(colour)).max(axis=2) <= tolerance)
@@ -160,6 +137,10 @@ class Frame(object):
         r, g, b = self.view[..., 0], self.view[..., 1], self.view[..., 2]
         return int(((r > 120) & (g < 0.25 * r) & (b < 0.25 * r)).sum())
 
+    def camera_green_pixels(self):
+        """The world file's pillar green in the left dock."""
+        return green_pixels(self.panel)
+
     def status_pixels(self):
         return dict((name, int(near(self.panel, colour).sum())) for name, colour in ERROR_COLOURS.items())
 
@@ -193,19 +174,9 @@ class RvizConfig(object):
         return tuple(int(part) for part in str(text).split(';'))
 
 
-# --- processes -----------------------------------------------------------------
-def start_xvfb():
-    """Xvfb on a display it picks itself (-displayfd 1 prints the number): (Child, ':N')."""
-    xvfb = Child(['Xvfb', '-displayfd', '1', '-screen', '0', '%dx%dx24' % SCREEN, '-nolisten', 'tcp'])
-    number = wait_for(lambda: re.search(r'^(\d+)$', xvfb.output(), re.M) or not xvfb.running(), 20.0, 0.05)
-    if not number or not xvfb.running():
-        description = xvfb.describe()
-        xvfb.stop()
-        raise AssertionError('Xvfb did not start: %s' % description)
-    return xvfb, ':' + number.group(1)
-
-
 class RvizRenders(unittest.TestCase):
+    circle = CIRCLE  # what is driven for the trail: the tutorial's circle, 0.2 m across
+
     @classmethod
     def setUpClass(cls):
         cls.xvfb = cls.rviz = None
@@ -232,7 +203,7 @@ class RvizRenders(unittest.TestCase):
         path = rospy.get_param('~rviz_config', '') or os.path.join(
             rospkg.RosPack().get_path('tb3_sim_bringup'), 'rviz', 'demo.rviz')
         cls.config = RvizConfig(path)
-        cls.xvfb, display = start_xvfb()
+        cls.xvfb, display = start_xvfb(die_with_parent=True)
         os.environ['DISPLAY'] = display  # rviz inherits it (Child passes the environment on)
         cls.rviz = Child(['rosrun', 'rviz', 'rviz', '-d', path])
         started = time.monotonic()
@@ -260,7 +231,7 @@ class RvizRenders(unittest.TestCase):
         wait_for(lambda: publisher.get_num_connections() > 0, 10.0)
         end = time.monotonic() + DRIVE_SECONDS
         while time.monotonic() < end and not rospy.is_shutdown():
-            publisher.publish(CIRCLE)
+            publisher.publish(cls.circle)
             time.sleep(0.1)
         publisher.publish(Twist())
         time.sleep(1.0)
@@ -320,6 +291,20 @@ class RvizRenders(unittest.TestCase):
                                 'driving added only %d red pixels of /odom arrows%s' % (added, self.where()))
 
 
+class RvizCameraRenders(RvizRenders):
+    """The same, and the camera image beside the 3D view. The Waffle (Pi) is
+    0.27 m wide: on the tutorial's circle of 0.2 m it would cover its own trail."""
+    circle = Twist()
+    circle.linear.x, circle.angular.z = 0.2, -0.4
+
+    def test_camera_image_is_shown_beside_the_3d_view(self):
+        green = self.rendered_frame().camera_green_pixels()
+        report('rviz_camera', camera_green_pixels=green)
+        self.assertGreaterEqual(green, MIN_CAMERA_GREEN, 'the Camera panel shows no image of the pillars '
+                                '(%d green pixels in the left dock)%s' % (green, self.where()))
+
+
 if __name__ == '__main__':
     init_test_node('test_rviz_renders')
-    rostest.rosrun('tb3_sim_nav', 'rviz_renders', RvizRenders)
+    camera = rospy.get_param('~camera', False)
+    rostest.rosrun('tb3_sim_nav', 'rviz_renders', RvizCameraRenders if camera else RvizRenders)
