@@ -5,7 +5,7 @@ prints medians over several runs, with the machine and the date, and marks
 each figure against its target. It starts one master on a free loopback port
 and stops everything it starts by process group (the demo's machinery).
 
-    python3 tools/bench.py [--runs N] [--parts rtf,cpu,floor,scripts]
+    python3 tools/bench.py [--runs N] [--parts rtf,cpu,floor,camera,scripts]
 """
 import argparse
 import datetime
@@ -18,6 +18,7 @@ import time
 from tb3_harness import report, tutorial
 from tb3_harness.measure import cpu_seconds, machine, memory_mib, sim_pid, sim_uri
 from tb3_harness.processes import Process, RunError, say, start_master, wait_until
+from tb3_harness.screen import start_xvfb
 from tb3_harness.tcpros_reader import TcprosReader
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -47,7 +48,19 @@ RTF_ROWS = [('1 robot, empty world, every topic read', EMPTY_WORLD, [''], {}, Fa
             ('10 robots, turtlebot3_world, every topic read', MULTI, THREE + [name for name, _ in SEVEN], {},
              False, None)]
 CPU_SCRIPT = 'odom_out_and_back.py'  # the tutorial script that reads tf
+FRAME_SIZES = [(320, 240), (640, 360), (640, 480), (1280, 720), (1920, 1080)]
+# (label, model, camera size and rate or None for the defaults, camera topics
+# read; None: rviz shows camera.rviz on a screen of its own)
+ALL_OF_THE_R200 = ['rgb/image_raw', 'depth/image_raw', 'depth/points']
+CAMERA_ROWS = [('waffle_pi, defaults', 'waffle_pi', None, None, ['rgb/image_raw']),
+               ('waffle_pi, 640 x 480 at 30 Hz (Gazebo\'s)', 'waffle_pi', (640, 480), 30.0, ['rgb/image_raw']),
+               ('waffle_pi, defaults, rviz showing camera.rviz', 'waffle_pi', None, None, None),
+               ('waffle_pi, 640 x 480 at 30 Hz, rviz showing camera.rviz', 'waffle_pi', (640, 480), 30.0, None),
+               ('waffle, defaults, colour, depth and cloud', 'waffle', None, None, ALL_OF_THE_R200),
+               ('waffle, 640 x 360 at 30 Hz, colour, depth and cloud', 'waffle', (640, 360), 30.0, ALL_OF_THE_R200),
+               ('waffle, 1920 x 1080 at 30 Hz (Gazebo\'s), all three', 'waffle', (1920, 1080), 30.0, ALL_OF_THE_R200)]
 PHYSICS_RATE = 100.0  # the simulator's default steps per sim second
+RVIZ_SETTLE = 15.0    # wall s for rviz to start and show the camera before measuring
 TARGETS = {'cpu': 5.0, 'startup': 3.0, 'speedup': 10.0}
 
 
@@ -130,6 +143,83 @@ def measure_rtf(log_dir, launch, robots, sensors, seconds, rospy_reader=False):
         if listener is not None:
             listener.close()
         sim.stop()
+
+
+def measure_frames(runs):
+    """Median wall and CPU ms to render one frame (colour and depth) of the
+    Waffle's camera in turtlebot3_world, by size, with pybullet's EGL plugin
+    on Mesa's llvmpipe (the simulator's choice) and, in a world without it,
+    with its TinyRenderer (once loaded, the plugin renders every image)."""
+    from tb3_sim_nav.camera import Camera
+    from tb3_sim_nav.params import resolve
+    from tb3_sim_nav.robot_model import load_model
+    from tb3_sim_nav.simulation import Simulation
+    from tb3_sim_nav.world_file import load_world
+    model = load_model(os.path.join(ROOT, 'urdf', 'turtlebot3_waffle.urdf'))
+    obstacles = load_world('turtlebot3_world', os.path.join(ROOT, 'worlds')).obstacles
+    costs, egl = {}, None
+    for name, cameras in (('egl', True), ('tiny', False)):
+        simulation = Simulation(resolve(lambda key, default: default), obstacles, cameras=cameras)
+        try:
+            if cameras:
+                import pybullet
+                egl = simulation.world.renderer != pybullet.ER_TINY_RENDERER
+            body = simulation.add_robot('', model, (-2.0, -0.5, 0.0, 0.0)).body
+            for width, height in FRAME_SIZES:
+                camera = Camera(body, model.cameras[0], width, height, model.cameras[0].horizontal_fov, 30.0)
+                camera.render()  # the first frame sets the renderer up
+                walls, cpus = [], []
+                for _ in range(runs * 3):
+                    wall, cpu = time.perf_counter(), time.process_time()
+                    camera.render()
+                    walls.append(1000.0 * (time.perf_counter() - wall))
+                    cpus.append(1000.0 * (time.process_time() - cpu))
+                costs[(name, width, height)] = (median(walls), median(cpus))
+                say('frame %d x %d, %s: %.1f ms wall, %.1f ms CPU' % ((width, height, name) + costs[(name, width, height)]))
+        finally:
+            simulation.close()
+    return costs, egl
+
+
+def measure_camera(log_dir, model, size, rate, topics, seconds):
+    """At factor 1 in turtlebot3_world, with the camera's `topics` read (None:
+    rviz shows camera.rviz on an Xvfb screen): sim seconds per wall second and
+    the simulator's CPU (% of a core)."""
+    import rosgraph
+    master = rosgraph.Master('/tb3_bench')
+    for key, value in zip(('camera_width', 'camera_height', 'camera_rate'), (size or (None, None)) + (rate,)):
+        if value is None:
+            if master.hasParam('/tb3_sim/' + key):
+                master.deleteParam('/tb3_sim/' + key)
+        else:
+            master.setParam('/tb3_sim/' + key, value)
+    for key in ('scan', 'imu'):
+        master.setParam('/tb3_sim/' + key, True)
+    sim = Process('camera_' + model, LAUNCH + [WALLED_WORLD, 'model:=' + model], log_dir)
+    readers, viewers = [], []
+    try:
+        readers = [TcprosReader(sim_uri, topic) for topic in ['/clock'] + ['/camera/' + topic for topic in topics or []]]
+        clock = readers[0]
+        wait_until(lambda: clock.clock is not None and clock.clock > 2.0, 120, '/clock')
+        if topics is None:
+            xvfb, display = start_xvfb()
+            viewers = [xvfb, Process('rviz', ['rosrun', 'rviz', 'rviz', '-d', os.path.join(ROOT, 'rviz', 'camera.rviz')],
+                                     log_dir, env=dict(os.environ, DISPLAY=display))]
+            time.sleep(RVIZ_SETTLE)
+        pid = sim_pid()
+        sim_start, wall_start, cpu_start = clock.clock, time.monotonic(), cpu_seconds(pid)
+        time.sleep(seconds)
+        sim_end, wall_end, cpu_end = clock.clock, time.monotonic(), cpu_seconds(pid)
+        return (sim_end - sim_start) / (wall_end - wall_start), 100.0 * (cpu_end - cpu_start) / (wall_end - wall_start)
+    finally:
+        for process in reversed(viewers):
+            process.stop()
+        for reader in readers:
+            reader.close()
+        sim.stop()
+        for key in ('camera_width', 'camera_height', 'camera_rate'):
+            if master.hasParam('/tb3_sim/' + key):
+                master.deleteParam('/tb3_sim/' + key)
 
 
 def measure_cpu_and_startup(log_dir, seconds):
@@ -226,10 +316,10 @@ def main(argv=None):
     parser.add_argument('--runs', type=int, default=3, help='runs per figure (median reported)')
     parser.add_argument('--seconds', type=float, default=10.0, help='wall s per real-time-factor run')
     parser.add_argument('--cpu-seconds', type=float, default=30.0, help='wall s of the CPU measurement')
-    parser.add_argument('--parts', default='rtf,cpu,floor,scripts',
+    parser.add_argument('--parts', default='rtf,cpu,floor,camera,scripts',
                         help='comma-separated: rtf (max real-time factor), cpu (CPU, memory, start-up), '
-                             'floor (CPU of a bare /clock loop, for scale), '
-                             'scripts (the tutorial scripts at factor 1 and 0); default all')
+                             'floor (CPU of a bare /clock loop, for scale), camera (frame costs, real time '
+                             'with a camera read), scripts (the tutorial scripts at factor 1 and 0); default all')
     parser.add_argument('--output', default=os.path.join(ROOT, 'bench_output'))
     args = parser.parse_args(argv)
     log_dir = os.path.join(args.output, 'logs')
@@ -265,6 +355,14 @@ def main(argv=None):
                 floor[physics].append(measure_floor(log_dir, args.cpu_seconds, physics))
                 say('floor%s, run %d: %.1f %% of a core' % (' with physics' if physics else '', run + 1,
                                                             floor[physics][-1]))
+        frames, egl, cameras = {}, None, {}
+        if 'camera' in parts:
+            frames, egl = measure_frames(args.runs)
+            for label, model, size, rate, topics in CAMERA_ROWS:
+                cameras[label] = [measure_camera(log_dir, model, size, rate, topics, args.cpu_seconds)
+                                  for _ in range(args.runs)]
+                say('camera %s: real-time factor %s, CPU %s' % (label, [round(r, 2) for r, _ in cameras[label]],
+                                                                [round(c, 1) for _, c in cameras[label]]))
         scripts = {}
         if 'scripts' in parts:
             for factor in (1.0, 0.0):
@@ -293,6 +391,18 @@ def main(argv=None):
         if floor:
             lines += ['%-58s %11.1f%%' % ('  floor: a python loop paced to 100 Hz publishing /clock', median(floor[False])),
                       '%-58s %11.1f%%' % ('  floor: the same, a pybullet step each tick', median(floor[True]))]
+        if frames:
+            lines.append('one frame of the Waffle\'s camera (colour and depth), wall / CPU ms, %s; TinyRenderer:'
+                         % ('EGL on llvmpipe' if egl else 'EGL not loaded: TinyRenderer'))
+            for width, height in FRAME_SIZES:
+                lines.append('%-58s %6.1f / %5.1f ms;  %6.1f / %5.1f ms' % (
+                    ('  %d x %d' % (width, height),) + frames[('egl', width, height)] + frames[('tiny', width, height)]))
+        if cameras:
+            lines.append('factor 1 in turtlebot3_world, the camera read: real-time factor, CPU of the simulator:')
+            for label, _, _, _, _ in CAMERA_ROWS:
+                factor = median([r for r, _ in cameras[label]])
+                lines.append('%-58s %7.2f  %5.1f%%  %s' % ('  ' + label, factor, median([c for _, c in cameras[label]]),
+                                                           'real time: %s' % verdict(factor >= 0.95)))
         if rss:
             lines.append('%-58s %8.0f MiB' % ('peak RSS of the simulator node (max over runs)', max(rss)))
         for script, _ in (tutorial.SCRIPTS if scripts else []):

@@ -11,9 +11,13 @@ import numpy as np
 import pybullet
 
 #: Without a width asked for, a camera gets its model's size scaled down to at
-#: most this wide: a 640 x 480 frame renders in about 17 ms here, 1920 x 1080
-#: (the RealSense R200's colour) in about 52 ms, too slow for 30 Hz at real time.
+#: most this wide, and without a rate, its model's at most this often (Hz of
+#: sim time). Every frame costs about 40 ms of CPU here, whatever its size up
+#: to 640 x 480: Gazebo's 30 Hz takes one and a half cores, and with rviz
+#: showing the image the simulator fell to 0.67 of real time; 15 Hz kept it at
+#: real time (bench, 2026-11-23). The R200's 1920 x 1080 costs 65 ms a frame.
 DEFAULT_MAX_WIDTH = 640
+DEFAULT_MAX_RATE = 15.0
 
 
 def camera_size(spec, width=None, height=None):

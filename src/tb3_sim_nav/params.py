@@ -134,7 +134,7 @@ class Config(object):
     camera_width: Optional[int] = _p(None, 'image width of the Waffle (Pi) camera; unset: the model\'s, at most 640 (the height follows the model\'s aspect)', _between(1, 4096), 'pixels', FROM_MODEL)
     camera_height: Optional[int] = _p(None, 'image height (unset: from the width and the model\'s aspect)', _between(1, 4096), 'pixels', FROM_MODEL)
     camera_horizontal_fov: Optional[float] = _p(None, "horizontal field of view; unset: the model's (waffle 1.3439, waffle_pi 1.085595)", _between(0.1, 3.0, ' rad'), 'rad', FROM_MODEL)
-    camera_rate: Optional[float] = _p(None, "camera rate (sim time), at most ~physics_rate; unset: the model's (30)", _positive, 'Hz', FROM_MODEL)
+    camera_rate: Optional[float] = _p(None, "camera rate (sim time), at most ~physics_rate; unset: the model's (Gazebo's 30), at most 15, to keep real time with rviz on 2 cores", _positive, 'Hz', FROM_MODEL)
     seed: int = _p(-1, 'seed of every noise source; -1 = different each run', _at_least(-1))
     profile: str = _p('gazebo', 'realism profile: chooses the defaults below', _one_of(*sorted(PROFILES)))
     odom_source: str = _p(None, 'odom from the true pose (Gazebo) or integrated from wheel encoders (firmware)', _one_of('world', 'encoders'), origin=FROM_PROFILE)

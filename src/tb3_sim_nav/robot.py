@@ -3,7 +3,7 @@
 The simulation steps it (`before_step`, the world's step, `after_step`); the
 ROS edge commands it and reads it off.
 """
-from .camera import Camera, camera_size
+from .camera import DEFAULT_MAX_RATE, Camera, camera_size
 from .diff_drive import Limits
 from .drive import Drive
 from .odometry import WheelOdometry, WorldOdometry
@@ -34,7 +34,7 @@ class Robot(object):
         self.imu = Imu(body, config.imu_gyro_noise, config.imu_accel_noise, rng) if config.imu else None
         self.cameras = [Camera(body, spec, *camera_size(spec, config.camera_width, config.camera_height),
                                horizontal_fov=config.camera_horizontal_fov or spec.horizontal_fov,
-                               rate=config.camera_rate or spec.rate)
+                               rate=config.camera_rate or min(spec.rate, DEFAULT_MAX_RATE))
                         for spec in model.cameras]
         self.reset()
 

@@ -39,10 +39,12 @@ class World(object):
     """Ground, obstacles and robots, in a pybullet client of their own.
 
     With `cameras`, images are rendered by pybullet's EGL plugin on Mesa's
-    software rasteriser (llvmpipe: 3 to 8 times faster than pybullet's own
-    TinyRenderer at 640 x 480 to 1920 x 1080); where EGL does not load,
-    TinyRenderer renders them. The plugin must be loaded before any body is
-    made, and fails on a body without a visual shape: the ground has one.
+    software rasteriser (llvmpipe, on every core: at 640 x 480 in half the
+    wall time of pybullet's own TinyRenderer, for the same CPU; at 1920 x 1080
+    in a sixth); where EGL does not load, TinyRenderer renders them. Once
+    loaded, the plugin renders every image of the client. It must be loaded
+    before any body is made, and fails on a body without a visual shape: the
+    ground has one.
     """
 
     def __init__(self, time_step=1.0 / 200, obstacles=(), gui=False, cameras=False):

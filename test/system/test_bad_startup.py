@@ -29,11 +29,12 @@ def cases(tmp_path):
     malformed = tmp_path / 'malformed_world.yaml'
     malformed.write_text(MALFORMED_WORLD)
     return {
-        # name: (launch file, arguments, what an error line must contain)
+        # name: (launch file, arguments, what an error line must contain[, private
+        # parameters of /tb3_sim set before roslaunch, as the README says to])
         'negative_real_time_factor': ('tb3_empty_world.launch', ['real_time_factor:=-1'],
                                       ['real_time_factor', '-1']),
-        'missing_urdf_model': ('tb3_empty_world.launch', ['model:=no_such_model'],
-                               ['turtlebot3_no_such_model.urdf']),
+        'unknown_model': ('tb3_empty_world.launch', ['model:=no_such_model'],
+                          ['no_such_model', 'the models are burger, waffle, waffle_pi']),
         'missing_world_file': ('tb3_empty_world.launch', ['world:=/nonexistent.yaml'],
                                ['world', '/nonexistent.yaml']),
         'malformed_world_file': ('tb3_empty_world.launch', ['world:=%s' % malformed],
@@ -43,11 +44,13 @@ def cases(tmp_path):
                                         ['x_pos', '(0.00, 0.00)']),
         'real_time_factor_not_a_number': ('tb3_empty_world.launch', ['real_time_factor:=fast'],
                                           ['real_time_factor', 'fast']),
+        'camera_rate_above_physics_rate': ('tb3_empty_world.launch', ['model:=waffle_pi'],
+                                           ['camera_rate', '500'], {'/tb3_sim/camera_rate': 500.0}),
     }
 
 
-CASES = ['negative_real_time_factor', 'missing_urdf_model', 'missing_world_file',
-         'malformed_world_file', 'spawn_inside_central_pillar', 'real_time_factor_not_a_number']
+CASES = ['negative_real_time_factor', 'unknown_model', 'missing_world_file', 'malformed_world_file',
+         'spawn_inside_central_pillar', 'real_time_factor_not_a_number', 'camera_rate_above_physics_rate']
 
 
 @pytest.fixture
@@ -57,7 +60,10 @@ def master(ros_port, processes):
 
 @pytest.mark.parametrize('case', CASES)
 def test_start_up_fails_nonzero_naming_parameter_or_file_and_value(case, master, processes, tmp_path):
-    launch, arguments, expected = cases(tmp_path)[case]
+    launch, arguments, expected, parameters = (cases(tmp_path)[case] + ({},))[:4]
+    import rosgraph
+    for name, value in parameters.items():
+        rosgraph.Master('/tb3_bad_startup_test').setParam(name, value)
     launched = processes.start('roslaunch_' + case, ['roslaunch', 'tb3_sim_bringup', launch] + arguments)
     ended = wait_until(lambda: not launched.running(), EXIT_WITHIN)
     with open(launched.log, errors='replace') as log:

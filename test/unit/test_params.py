@@ -136,3 +136,28 @@ def test_an_unknown_model_is_refused_naming_the_three():
 
 def test_the_model_defaults_to_the_burger():
     assert resolve(lambda name, default: default).model == 'burger'
+
+
+@pytest.mark.parametrize('name, value, problem', [
+    ('camera_width', 0, 'must be between 1 and 4096'),
+    ('camera_width', -640, 'must be between 1 and 4096'),
+    ('camera_height', 0, 'must be between 1 and 4096'),
+    ('camera_height', 100000, 'must be between 1 and 4096'),
+    ('camera_width', 640.5, 'must be a int'),
+    ('camera_horizontal_fov', 0.0, 'must be between 0.1 and 3.0 rad'),
+    ('camera_horizontal_fov', 3.5, 'must be between 0.1 and 3.0 rad'),
+    ('camera_horizontal_fov', math.nan, 'must be a finite float'),
+    ('camera_rate', 0.0, 'must be > 0'),
+    ('camera_rate', 200.0, 'must not exceed ~physics_rate = 100.0'),
+])
+def test_a_camera_parameter_out_of_range_is_refused_by_name(resolve_with, name, value, problem):
+    with pytest.raises(ParameterError) as error:
+        resolve_with(**{name: value})
+    message = str(error.value)
+    assert '~' + name in message and problem in message
+
+
+def test_camera_parameters_unset_are_the_models():
+    config = resolve(lambda name, default: default)
+    assert (config.camera_width, config.camera_height, config.camera_horizontal_fov, config.camera_rate) == (
+        None, None, None, None)
