@@ -32,7 +32,8 @@ def main():
     stop_following_clock()
     world = World(time_step=1.0 / PHYSICS_RATE) if args.physics else None
     if world:
-        world.add_robot(os.path.join(HERE, '..', 'urdf', 'turtlebot3_burger.urdf'), (0.0, 0.0, 0.0, 0.0))
+        with open(os.path.join(HERE, '..', 'urdf', 'turtlebot3_burger.urdf')) as urdf:
+            world.add_robot(urdf.read(), (0.0, 0.0, 0.0, 0.0))
     clock = Publishers(Throttle(10.0)).advertise('clock', Clock)
     pacer = Pacer(1.0)
     steps = 0

@@ -32,8 +32,8 @@ DriveGeometry = namedtuple('DriveGeometry', 'wheel_radius wheel_separation')
 CameraSpec = namedtuple('CameraSpec', 'link name depth width height horizontal_fov near far rate frame '
                                       'image_topic info_topic depth_topic depth_info_topic points_topic cutoff')
 
-#: Everything the simulator takes from a robot's URDF.
-RobotModel = namedtuple('RobotModel', 'urdf_file name geometry limits casters cameras')
+#: Everything the simulator takes from a robot's URDF (its text too; urdf_file is None for one spawned as text).
+RobotModel = namedtuple('RobotModel', 'urdf_file urdf_text name geometry limits casters cameras')
 
 
 class ModelError(ValueError):
@@ -62,13 +62,24 @@ def root_link(robot):
     return roots[0]
 
 
-def urdf_for_pybullet(urdf_path):
-    """The URDF's text with a tiny <inertial> added to a root link that has none."""
-    robot = _parse(urdf_path)
+def _completed(robot):
     root = root_link(robot)
     if root.find('inertial') is None:
         root.append(ElementTree.fromstring(ROOT_INERTIAL))
     return ElementTree.tostring(robot, encoding='unicode')
+
+
+def urdf_for_pybullet(urdf_path):
+    """The URDF's text with a tiny <inertial> added to a root link that has none."""
+    return _completed(_parse(urdf_path))
+
+
+def urdf_text_for_pybullet(text):
+    """The same, for a URDF's text."""
+    try:
+        return _completed(ElementTree.fromstring(text))
+    except ElementTree.ParseError as error:
+        raise ModelError('the URDF is not valid XML: %s' % error)
 
 
 def _drive_geometry(robot, urdf_path):
@@ -177,9 +188,24 @@ def _cameras(robot, urdf_path):
 def load_model(urdf_path):
     """The RobotModel of a URDF file, or ModelError naming the file and what it lacks."""
     robot = _parse(urdf_path)
+    with open(urdf_path) as urdf:
+        return _model(robot, urdf.read(), urdf_path, urdf_path)
+
+
+def load_model_text(text, name):
+    """The RobotModel of a URDF's text (a spawn request's), or ModelError."""
+    where = 'the URDF of %s' % name
+    try:
+        robot = ElementTree.fromstring(text)
+    except ElementTree.ParseError as error:
+        raise ModelError('%s is not valid XML: %s' % (where, error))
+    return _model(robot, text, where, None)
+
+
+def _model(robot, text, urdf_path, urdf_file):
     casters = tuple(sorted(link.get('name') for link in robot.iter('link')
                            if link.get('name', '').startswith(CASTER_PREFIX)))
-    return RobotModel(urdf_file=urdf_path, name=robot.get('name', ''),
+    return RobotModel(urdf_file=urdf_file, urdf_text=text, name=robot.get('name', ''),
                       geometry=_drive_geometry(robot, urdf_path), limits=_limits(robot, urdf_path),
                       casters=casters, cameras=_cameras(robot, urdf_path))
 

@@ -9,7 +9,6 @@ from collections import namedtuple
 import numpy as np
 import pybullet
 
-from .world import GRAVITY
 
 ImuReading = namedtuple('ImuReading', 'orientation angular_velocity linear_acceleration')
 
@@ -77,7 +76,7 @@ class Imu(object):
             acceleration = (linear - self._last[1]) / (now - self._last[0])
         self._last = (now, linear)
         base_from_world = np.reshape(pybullet.getMatrixFromQuaternion(orientation), (3, 3)).T
-        specific_force = base_from_world.dot(acceleration + (0.0, 0.0, GRAVITY))
+        specific_force = base_from_world.dot(acceleration - np.asarray(self.body.world.gravity))
         rates = base_from_world.dot(angular)
         if self.gyro_noise > 0.0:
             rates = rates + self.rng.normal(0.0, self.gyro_noise, 3)

@@ -38,7 +38,7 @@ WorldSpec = namedtuple('WorldSpec', 'obstacles robots')
 _SHAPE_KEYS = {'box': {'size'}, 'cylinder': {'radius', 'height'}}
 _OPTIONAL_KEYS = {'position', 'yaw', 'color', 'name'}
 _ROBOT_KEYS = {'name', 'model', 'position', 'yaw'}
-_NAME = re.compile(r'[A-Za-z][A-Za-z0-9_]*$')  # a ROS graph name without slashes
+ROBOT_NAME = re.compile(r'[A-Za-z][A-Za-z0-9_]*$')  # a ROS graph name without slashes
 
 
 class WorldError(ValueError):
@@ -109,7 +109,7 @@ def _robot(entry):
     if missing or unknown:
         raise ValueError('missing %s, unknown %s' % (sorted(missing) or 'nothing', sorted(unknown) or 'nothing'))
     name, model = entry['name'], entry['model']
-    if not isinstance(name, str) or not _NAME.match(name):
+    if not isinstance(name, str) or not ROBOT_NAME.match(name):
         raise ValueError('name %r must be a ROS name: a letter, then letters, digits or _' % (name,))
     if not isinstance(model, str) or not model:
         raise ValueError('robot %s: model must be burger, waffle, waffle_pi or a URDF path, not %r'

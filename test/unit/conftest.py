@@ -40,7 +40,7 @@ def world_factory(burger_urdf):
     def make(time_step, settle, spawn_pose=(0.0, 0.0, 0.0, 0.0), obstacles=()):
         world = World(time_step, obstacles)
         worlds.append(world)
-        robot = world.add_robot(model.urdf_file, spawn_pose, casters=model.casters)
+        robot = world.add_robot(model.urdf_text, spawn_pose, casters=model.casters)
         for _ in range(int(round(settle / time_step))):
             world.step()
         return robot

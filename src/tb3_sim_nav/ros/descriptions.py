@@ -41,11 +41,9 @@ class Descriptions(object):
         if not robot.name:
             return
         namespace = rospy.resolve_name(robot.name)
-        with open(robot.model.urdf_file) as urdf:
-            description = urdf.read()
         name = namespace + '/robot_description'
-        rospy.set_param(name, description)
-        self.parameters[name] = description
+        rospy.set_param(name, robot.model.urdf_text)
+        self.parameters[name] = robot.model.urdf_text
         if not self._run:
             return
         executable = roslib.packages.find_node('robot_state_publisher', 'robot_state_publisher')
