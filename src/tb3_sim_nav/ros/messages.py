@@ -7,6 +7,7 @@ import numpy as np
 from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan, PointCloud2, PointField
+from visualization_msgs.msg import Marker, MarkerArray
 
 from ..robot_model import LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT
 
@@ -150,3 +151,31 @@ def fill_points(message, stamp, xyz, rgb):
     cloud['rgb'] = packed.view(np.float32)
     message.header.stamp = stamp
     message.data = cloud.tobytes()
+
+
+MARKER_TYPES = {'box': Marker.CUBE, 'cylinder': Marker.CYLINDER, 'sphere': Marker.SPHERE}
+
+
+def world_markers(frame, shapes, stamp):
+    """A MarkerArray of (model name, model_files.Shape) pairs, in `frame`: the
+    last ones cleared first, then one marker per shape (namespace: its model),
+    locked to `frame` so rviz moves them with it."""
+    array = MarkerArray(markers=[Marker(action=Marker.DELETEALL)])
+    array.markers[0].header.frame_id = frame
+    for index, (name, shape) in enumerate(shapes):
+        marker = Marker(ns=name, id=index, type=MARKER_TYPES[shape.kind], action=Marker.ADD, frame_locked=True)
+        marker.header.frame_id, marker.header.stamp = frame, stamp
+        (position, orientation) = shape.pose
+        marker.pose.position.x, marker.pose.position.y, marker.pose.position.z = position
+        (marker.pose.orientation.x, marker.pose.orientation.y, marker.pose.orientation.z,
+         marker.pose.orientation.w) = orientation
+        if shape.kind == 'box':
+            marker.scale.x, marker.scale.y, marker.scale.z = shape.size
+        elif shape.kind == 'cylinder':
+            marker.scale.x = marker.scale.y = 2.0 * shape.size[0]
+            marker.scale.z = shape.size[1]
+        else:
+            marker.scale.x = marker.scale.y = marker.scale.z = 2.0 * shape.size[0]
+        marker.color.r, marker.color.g, marker.color.b, marker.color.a = shape.color
+        array.markers.append(marker)
+    return array

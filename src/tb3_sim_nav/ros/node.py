@@ -4,7 +4,9 @@ One physics step gives one timestamp to everything it publishes; each step's
 data goes out before its /clock tick.
 """
 import dataclasses
+import math
 import os
+import queue
 import sys
 import threading
 import time
@@ -14,14 +16,17 @@ import rospy
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty, EmptyResponse
 from tf2_msgs.msg import TFMessage
+from visualization_msgs.msg import MarkerArray
 
 from .. import params
 from ..pacing import Pacer, Schedule
 from ..robot_model import ModelError, load_model, model_urdf
 from ..throttle import Throttle
-from ..world_file import RobotSpec, WorldError, load_world
-from . import rospy_internals
+from ..simulation import ModelStateError
+from ..world_file import ROBOT_NAME, RobotSpec, WorldError, load_world
+from . import messages, rospy_internals
 from .descriptions import Descriptions
+from .gazebo import GazeboInterface
 from .lockstep import LOCKSTEP_POLL, LOCKSTEP_POLL_SHARE, Lockstep
 from .master_watch import MasterWatch
 from .publishers import Publishers
@@ -29,6 +34,7 @@ from .robot_io import RobotIO
 
 WARN_PERIOD = 5.0    # s between repeats of the same warning
 IDLE_POLL = 0.01     # wall s between checks while paused or holding
+REQUEST_TIMEOUT = 10.0  # wall s a service waits for the step loop to take its request
 RESTORED_PARAMETERS = ('/use_sim_time', '/robot_description')  # set again on a new master
 
 
@@ -40,7 +46,7 @@ class SimulatorNode(object):
         self.sim = simulation
         self.descriptions = descriptions
         self.pacer = Pacer(config.real_time_factor, paused=config.paused)
-        self._lock = threading.Lock()  # steps versus the services that change the world
+        self._requests = queue.Queue()  # work of other threads, for the step loop
         self._throttle = Throttle(WARN_PERIOD)
         self._hold_until = 0.0
         self._due = dict((name, Schedule(round(1e9 / rate))) for name, rate in (
@@ -61,6 +67,9 @@ class SimulatorNode(object):
         self.robots = {}  # name -> RobotIO
         for robot in simulation.robots.values():
             self._add_io(robot)
+        self.markers_pub = self.publishers.advertise('world_markers', MarkerArray, latch=True)
+        self.world_changed()
+        self.gazebo = GazeboInterface(self)
         self._own_clock = rospy_internals.stop_following_clock()
         for name, handler in (('pause_physics', self._on_pause), ('unpause_physics', self._on_unpause),
                               ('reset_world', self._on_reset_world),
@@ -70,10 +79,80 @@ class SimulatorNode(object):
     def _add_io(self, robot):
         io = self.robots[robot.name] = RobotIO(robot, self.config, self.publishers, self._throttle,
                                                 self._command_received if self.lockstep else None)
-        self._tf.transforms = [other.transform for other in self.robots.values()]
+        self._update_tf()
         if self.lockstep:
             self.lockstep.follow(io.cmd_vel)
         self.descriptions.start(robot)
+
+    def _update_tf(self):
+        """One tf message for every robot's odom -> base and world -> odom."""
+        self._tf.transforms = [io.transform for io in self.robots.values()] + [
+            io.world_transform for io in self.robots.values() if io.world_transform is not None]
+
+    def spawn_robot(self, name, model, pose, model_name):
+        """A robot spawned while running (in the step loop): it gets what a launched one has."""
+        if not ROBOT_NAME.match(name):
+            raise ModelStateError('robot_namespace %r must be a ROS name: a letter, then letters, digits or _' % name)
+        (x, y, z), orientation = pose
+        yaw = math.atan2(2.0 * (orientation[3] * orientation[2] + orientation[0] * orientation[1]),
+                         1.0 - 2.0 * (orientation[1] ** 2 + orientation[2] ** 2))
+        try:
+            robot = self.sim.add_robot(name, model, (x, y, z, yaw), model_name)
+        except ValueError as error:
+            raise ModelStateError(str(error))
+        self._add_io(robot)
+        rospy.loginfo('spawned robot %s (model %s) at (%.2f, %.2f) yaw %.2f', name, model_name, x, y, yaw)
+
+    def forget_robot(self, robot):
+        """A deleted robot's interface closed (in the step loop)."""
+        io = self.robots.pop(robot.name)
+        if self.lockstep:
+            self.lockstep.forget(io.cmd_vel)
+        io.close()
+        self.descriptions.stop(robot.name)
+        self._update_tf()
+
+    def world_changed(self, stamp=None):
+        """The world's obstacles and objects drawn anew on world_markers (latched)."""
+        frame = self.config.world_frame or self.config.odom_frame
+        self.markers_pub.publish(messages.world_markers(frame, self.sim.world.visual_shapes(),
+                                                        stamp or rospy.Time(*divmod(self.sim.now_ns, 1000000000))))
+
+    def run_in_loop(self, work, timeout=REQUEST_TIMEOUT):
+        """work()'s result, run by the step loop between steps; its exception raised here."""
+        done, result = threading.Event(), {}
+        self._requests.put((work, done, result))
+        if not done.wait(timeout):
+            raise ModelStateError('the simulator did not get to the request within %g s (wall)' % timeout)
+        if 'error' in result:
+            raise result['error']
+        return result.get('value')
+
+    def _serve_requests(self):
+        while True:
+            try:
+                work, done, result = self._requests.get_nowait()
+            except queue.Empty:
+                return
+            try:
+                result['value'] = work()
+            except Exception as error:  # handed back to the thread that asked
+                result['error'] = error
+            done.set()
+
+    def warn_throttled(self, kind, text):
+        if self._throttle.allow(kind):
+            rospy.logwarn('%s (at most one such warning per %g s)', text, WARN_PERIOD)
+
+    def fastest_output(self):
+        """(parameter name, rate) of the fastest output: physics may not step slower."""
+        rates = [('odom_rate', self.config.odom_rate), ('joint_states_rate', self.config.joint_states_rate),
+                 ('scan_rate', self.config.scan_rate), ('imu_rate', self.config.imu_rate)] + [
+            ('camera_rate', camera.rate) for robot in self.sim.robots.values() for camera in robot.cameras]
+        return max(rates, key=lambda item: item[1])
+
+    def set_real_time_factor(self, factor):
+        self.pacer.set_factor(factor)
 
     # --- inputs -------------------------------------------------------------
     def _command_received(self):
@@ -93,35 +172,40 @@ class SimulatorNode(object):
         self.pacer.resume()
         return EmptyResponse()
 
+    def _reset_world(self):
+        self.sim.reset_world()
+        self.world_changed()
+
     def _on_reset_world(self, _request):
-        with self._lock:
-            self.sim.reset_world()
-        rospy.loginfo('reset_world: every robot back at its spawn pose, odometry zeroed')
+        self.run_in_loop(self._reset_world)
+        rospy.loginfo('reset_world: every robot and object back at its spawn pose, odometry zeroed')
         return EmptyResponse()
 
+    def _reset_simulation(self):
+        self.sim.reset_simulation()
+        self.pacer.restart()
+        self.world_changed()
+
     def _on_reset_simulation(self, _request):
-        with self._lock:
-            self.sim.reset_simulation()
-            self.pacer.restart()
-        rospy.loginfo('reset_simulation: every robot back at its spawn pose, time back to zero')
+        self.run_in_loop(self._reset_simulation)
+        rospy.loginfo('reset_simulation: every robot and object back at its spawn pose, time back to zero')
         return EmptyResponse()
 
     # --- the step loop ------------------------------------------------------
     def run(self):
-        step_s = self.sim.step_ns * 1e-9
         while not rospy.is_shutdown():
+            self._serve_requests()
             if self.pacer.paused or time.monotonic() < self._hold_until:
                 self.pacer.restart()
                 self.publishers.flush()
                 time.sleep(IDLE_POLL)
                 continue
-            self.pacer.wait_until((self.sim.steps + 1) * step_s)
+            self.pacer.wait_until((self.sim.now_ns + self.sim.step_ns) * 1e-9)
             # Each step waits for the nodes' reaction to the last tick. Paced,
             # they have had the sleep to react: one look mostly finds them done.
             if self.lockstep:
                 self.lockstep.wait()
-            with self._lock:
-                self.step()
+            self.step()
 
     def step(self):
         now_ns = self.sim.now_ns
@@ -133,6 +217,7 @@ class SimulatorNode(object):
         # /clock to a new subscriber from another thread, so it must not change.
         stamp = rospy.Time(*divmod(now_ns, 1000000000))
         published = self.publish_data(now_ns, stamp)
+        self.gazebo.publish()
         self.publishers.flush()
         # The step's data goes out before /clock says its time has come, so a
         # node woken by the tick reads this step's tf and odom, not the step
@@ -152,6 +237,8 @@ class SimulatorNode(object):
             for io in robots:
                 io.publish_odometry(stamp)
             self.tf_pub.publish(self._tf)
+            if any(not body.static for body in self.sim.world.objects.values()):
+                self.world_changed(stamp)  # what moves is drawn where it is now
             published = True
         if due['joint_states'].due(now_ns):
             for io in robots:

@@ -11,6 +11,7 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan, PointCloud2
 
 from ..diff_drive import sanitize_twist
+from ..frames import compose, inverse
 from ..pacing import Schedule
 from ..robot import LIDAR_LINK
 from . import messages
@@ -32,6 +33,9 @@ class RobotIO(object):
         self.odom = messages.odometry(odom_frame, base_frame)
         self.truth = messages.odometry(odom_frame, base_frame, covariance=False)
         self.transform = messages.transform(odom_frame, base_frame)
+        # world -> odom: where odometry puts the world, so that what is drawn in
+        # the world frame appears under the lidar's dots in any profile.
+        self.world_transform = messages.transform(config.world_frame, odom_frame) if config.world_frame else None
         self.joints = messages.joint_states()
         self.odom_pub = publishers.advertise(prefix + 'odom', Odometry)
         self.truth_pub = publishers.advertise(prefix + 'base_pose_ground_truth', Odometry)
@@ -76,6 +80,8 @@ class RobotIO(object):
         messages.fill_odometry(self.odom, stamp, pose, twist)
         messages.fill_odometry(self.truth, stamp, *truth)
         messages.fill_transform(self.transform, stamp, pose)
+        if self.world_transform is not None:
+            messages.fill_transform(self.world_transform, stamp, compose(truth[0], inverse(pose)))
         self.odom_pub.publish(self.odom)
         self.truth_pub.publish(self.truth)
 
