@@ -1,0 +1,69 @@
+"""ROBOTIS' worlds through their launches, started as a user starts them.
+
+For each of tb3_house.launch and tb3_stage_1.launch ... tb3_stage_4.launch,
+against a roscore of its own (a free loopback port) and with
+TURTLEBOT3_MODEL=burger in the environment, as a TurtleBot3 user has it:
+`roslaunch tb3_sim_bringup LAUNCH` with no arguments, then `rostopic echo -n 1`
+of /base_pose_ground_truth (after REST s of sim time) and of /scan. The robot
+must rest where the launch file's defaults put it, and its lidar must see
+walls. What the lidar sees, beam for beam, is test/unit/test_known_worlds.py's.
+"""
+import math
+import os
+import xml.etree.ElementTree as ElementTree
+
+import pytest
+import yaml
+
+from tb3_system_utils import run
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+LAUNCHES = ['tb3_house.launch', 'tb3_stage_1.launch', 'tb3_stage_2.launch', 'tb3_stage_3.launch',
+            'tb3_stage_4.launch']
+REST = 1.0          # sim s after which the robot must rest at its spawn pose
+AT_SPAWN = 0.01     # m
+TIMEOUT = 60.0      # wall s for a message to come
+
+
+def spawn_of(launch):
+    """(x, y) of a launch file's argument defaults."""
+    root = ElementTree.parse(os.path.join(REPO, 'launch', launch)).getroot()
+    defaults = {arg.get('name'): arg.get('default') for arg in root.iter('arg')}
+    return float(defaults['x_pos']), float(defaults['y_pos'])
+
+
+def echo(topic, sim):
+    """One message of `topic` as `rostopic echo -n 1` prints it, parsed."""
+    printed = run(['rostopic', 'echo', '-n', '1', topic], TIMEOUT)
+    assert printed.returncode == 0, 'rostopic echo -n 1 %s: %s (exit %r); %s' % (
+        topic, printed.stdout[-1000:], printed.returncode, sim.describe())
+    return next(yaml.safe_load_all(printed.stdout))
+
+
+def stamp(message):
+    return message['header']['stamp']['secs'] + 1e-9 * message['header']['stamp']['nsecs']
+
+
+@pytest.mark.parametrize('launch', LAUNCHES)
+def test_the_robot_rests_at_the_launch_spawn_pose_and_its_lidar_sees_walls(launch, ros_port, processes):
+    processes.start_master('roscore', ros_port)
+    sim = processes.start('roslaunch', ['roslaunch', 'tb3_sim_bringup', launch],
+                          env=dict(os.environ, TURTLEBOT3_MODEL='burger'))
+    truth = echo('/base_pose_ground_truth', sim)
+    while stamp(truth) < REST:
+        truth = echo('/base_pose_ground_truth', sim)
+    scan = echo('/scan', sim)
+    position, orientation = truth['pose']['pose']['position'], truth['pose']['pose']['orientation']
+    yaw = 2.0 * math.atan2(orientation['z'], orientation['w'])
+    ranges = [float(value) for value in scan['ranges']]  # rostopic prints inf, which YAML reads as a string
+    seen = [value for value in ranges if math.isfinite(value)]
+    x, y = spawn_of(launch)
+    print('MEASURED %s: at t %.2f s (x, y, yaw) = (%.4f, %.4f, %.4f), spawn (%.2f, %.2f); '
+          'scan at t %.2f s: %d of %d beams hit, %.2f to %.2f m'
+          % (launch, stamp(truth), position['x'], position['y'], yaw, x, y, stamp(scan), len(seen), len(ranges),
+             min(seen, default=math.nan), max(seen, default=math.nan)))
+    assert sim.running(), sim.describe()
+    assert math.hypot(position['x'] - x, position['y'] - y) <= AT_SPAWN
+    assert abs(yaw) <= 0.01  # ROBOTIS' launches have no yaw: heading 0
+    assert scan['header']['frame_id'] == 'base_scan' and len(ranges) == 360
+    assert len(seen) >= len(ranges) // 4, ranges  # the lidar sees walls
