@@ -25,7 +25,12 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 LAUNCH = ['roslaunch', '--wait', 'tb3_sim_bringup']
 EMPTY_WORLD, WALLED_WORLD = 'tb3_empty_world.launch', 'tb3_world.launch'  # the tutorial's two
-MULTI = 'multi_tb3.launch'  # three robots in turtlebot3_world
+MULTI_HOUSE = 'multi_tb3.launch'  # as it starts: three robots in turtlebot3_house, far apart
+# The same three in turtlebot3_world, within each other's lidar range, as test/multi_tb3.test has them.
+MULTI_WORLD = ' '.join(['multi_tb3.launch', 'world:=turtlebot3_world'] + [
+    '%s_tb3_%s:=%g' % (robot, key, value) for robot, pose in
+    (('first', (-2.0, -0.5, 0.0)), ('second', (-2.0, 0.5, 0.0)), ('third', (-1.5, 1.6, -0.8)))
+    for key, value in zip(('x_pos', 'y_pos', 'yaw'), pose)])
 GLOBAL_TOPICS = ['clock', 'tf']
 ROBOT_TOPICS = ['odom', 'joint_states', 'base_pose_ground_truth', 'scan', 'imu']
 TOPICS = GLOBAL_TOPICS + ROBOT_TOPICS
@@ -33,7 +38,7 @@ THREE = ['tb3_0', 'tb3_1', 'tb3_2']
 #: Seven more robots for ten in turtlebot3_world, between the pillars.
 SEVEN = [('tb3_%d' % (3 + index), position) for index, position in enumerate(
     [(0.55, 0.55), (-0.55, 0.55), (0.55, -0.55), (-0.55, -0.55), (1.65, 0.55), (1.65, -0.55), (0.55, 1.65)])]
-# (label, launch file, its robots' names, sensors switched off, read by a
+# (label, launch file and arguments, its robots' names, sensors switched off, read by a
 # rospy node, target). Each topic of each robot is read by a TcprosReader
 # (nearly free), or by one rospy node, which handles each message in python.
 # In the empty world no lidar beam can hit anything, and none is cast;
@@ -44,8 +49,10 @@ RTF_ROWS = [('1 robot, empty world, every topic read', EMPTY_WORLD, [''], {}, Fa
             ('  the same without scan and imu', EMPTY_WORLD, [''], {'scan': False, 'imu': False}, False, None),
             ('  the same, every topic read by a rospy node', EMPTY_WORLD, [''], {}, True, None),
             ('1 robot, turtlebot3_world, every topic read', WALLED_WORLD, [''], {}, False, 30.0),
-            ('3 robots, turtlebot3_world, every topic read', MULTI, THREE, {}, False, 10.0),
-            ('10 robots, turtlebot3_world, every topic read', MULTI, THREE + [name for name, _ in SEVEN], {},
+            ('3 robots, turtlebot3_world, every topic read', MULTI_WORLD, THREE, {}, False, 10.0),
+            ('3 robots, turtlebot3_house (multi_tb3.launch), every topic read', MULTI_HOUSE, THREE, {}, False,
+             None),
+            ('10 robots, turtlebot3_world, every topic read', MULTI_WORLD, THREE + [name for name, _ in SEVEN], {},
              False, None)]
 CPU_SCRIPT = 'odom_out_and_back.py'  # the tutorial script that reads tf
 FRAME_SIZES = [(320, 240), (640, 360), (640, 480), (1280, 720), (1920, 1080)]
@@ -97,19 +104,19 @@ class Listener(object):
 def start_sim(name, log_dir, factor, launch=EMPTY_WORLD, sensors=None, robots=('',)):
     """One of the tutorial's launches at `factor`; `sensors` maps 'scan' and
     'imu' to False to switch them off (private parameters of /tb3_sim); more
-    than three `robots`: the seven of SEVEN join multi_tb3.launch's three."""
+    than three `robots`: the seven of SEVEN join MULTI_WORLD's three."""
     import rosgraph
     master = rosgraph.Master('/tb3_bench')
     for key in ('scan', 'imu'):
         master.setParam('/tb3_sim/' + key, (sensors or {}).get(key, True))
-    argv = LAUNCH + [launch, 'real_time_factor:=%g' % factor]
+    argv = LAUNCH + launch.split() + ['real_time_factor:=%g' % factor]
     if len(robots) > len(THREE):
         world = os.path.join(log_dir, 'ten_robots.yaml')
         with open(os.path.join(ROOT, 'worlds', 'turtlebot3_world.yaml')) as walls, open(world, 'w') as ten:
             ten.write(walls.read() + 'robots:\n' + ''.join(
                 '  - {name: %s, model: burger, position: [%g, %g]}\n' % ((name,) + position)
                 for name, position in SEVEN))
-        argv.append('world:=' + world)
+        argv.append('world:=' + world)  # roslaunch: the last world:= wins
     return Process(name, argv, log_dir)
 
 

@@ -39,8 +39,13 @@ fi
 # What rostest cannot stage (its master is its own): a master killed and
 # restarted, bad start-up configurations, and the tutorial's scripts run at
 # factors 1, 5 and 0 against one another (a fresh simulator for each run).
-echo "== system tests (pytest, masters of their own)"
-run system python3 -m pytest -q -p no:cacheprovider test/system
+# One pytest process per file: a process can be one rospy node only, and each
+# file that is one talks to a master of its own.
+for test_file in test/system/test_*.py; do
+  name=$(basename "$test_file" .py)
+  echo "== system tests: $name (pytest, masters of their own)"
+  run "$name" python3 -m pytest -q -p no:cacheprovider "$test_file"
+done
 
 for test_file in test/*.test; do
   name=$(basename "$test_file")

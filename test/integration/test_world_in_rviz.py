@@ -13,6 +13,11 @@ base_scan to world, at the scan's stamp: each within MAX_OFF of the surface
 of an obstacle of the world file (read independently here), for at least
 MIN_SHARE of the finite beams. Without the world -> odom correction they
 would be off by the drift.
+
+Then /gazebo/set_model_state teleports the robot back to its spawn pose:
+the encoders saw no wheel turn, so odom stays where it was (within
+STILL) while the truth jumps; tf world -> odom takes the jump, so tf's
+world -> base_footprint is the truth again.
 """
 import math
 import unittest
@@ -23,6 +28,8 @@ import rospy
 import rostest
 import tf2_ros
 import yaml
+from gazebo_msgs.msg import ModelState
+from gazebo_msgs.srv import SetModelState
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan
@@ -35,6 +42,8 @@ MAX_OFF = 0.03     # m, a lidar point from an obstacle's surface (noise is 1 cm)
 MIN_SHARE = 0.95
 DRIVE_SECONDS = 20.0
 TIMEOUT = 30.0
+SPAWN = (-2.0, -0.5)  # tb3_world.launch's
+STILL = 0.005      # m, odom's move across the teleport (the robot settles where it lands)
 
 
 def surface_distance(point, obstacle):
@@ -123,6 +132,26 @@ class WorldInRviz(unittest.TestCase):
         drawn = [marker for marker in self.markers.markers if marker.ns]
         self.assertEqual(len(drawn), len(self.obstacles))
         self.assertTrue(all(marker.header.frame_id == 'world' and marker.frame_locked for marker in drawn))
+
+    def test_teleported_odom_stays_while_the_truth_and_world_to_odom_jump(self):
+        odom_before = rospy.wait_for_message('/odom', Odometry, TIMEOUT).pose.pose.position
+        state = ModelState(model_name='turtlebot3_burger')
+        state.pose.position.x, state.pose.position.y = SPAWN
+        state.pose.orientation.w = 1.0
+        rospy.wait_for_service('/gazebo/set_model_state', TIMEOUT)
+        answer = rospy.ServiceProxy('/gazebo/set_model_state', SetModelState)(state)
+        self.assertTrue(answer.success, answer.status_message)
+        self.truth.wait_sim(0.5)
+        truth = self.truth.latest()
+        odom = rospy.wait_for_message('/odom', Odometry, TIMEOUT)
+        odom_moved = math.hypot(odom.pose.pose.position.x - odom_before.x, odom.pose.pose.position.y - odom_before.y)
+        seen = self.buffer.lookup_transform('world', 'base_footprint', odom.header.stamp,
+                                            rospy.Duration(TIMEOUT)).transform.translation
+        report('teleport_realistic', truth=(truth.x, truth.y), odom_moved_m=odom_moved, tf_world_base=(seen.x, seen.y))
+        self.assertAlmostEqual(truth.x, SPAWN[0], delta=0.01)
+        self.assertAlmostEqual(truth.y, SPAWN[1], delta=0.01)
+        self.assertLess(odom_moved, STILL)
+        self.assertLess(math.hypot(seen.x - truth.x, seen.y - truth.y), 0.01)
 
 
 if __name__ == '__main__':

@@ -67,3 +67,26 @@ def test_the_robot_rests_at_the_launch_spawn_pose_and_its_lidar_sees_walls(launc
     assert abs(yaw) <= 0.01  # ROBOTIS' launches have no yaw: heading 0
     assert scan['header']['frame_id'] == 'base_scan' and len(ranges) == 360
     assert len(seen) >= len(ranges) // 4, ranges  # the lidar sees walls
+
+
+def test_multi_tb3_launch_puts_three_robots_in_the_house_as_robotis_does(ros_port, processes):
+    """`roslaunch tb3_sim_bringup multi_tb3.launch`, no arguments: tb3_0, tb3_1 and tb3_2 rest at the
+    launch's default poses in turtlebot3_house (ROBOTIS': (-7, -1) and (7, -1) facing +y, (0.5, 3))."""
+    processes.start_master('roscore', ros_port)
+    sim = processes.start('roslaunch', ['roslaunch', 'tb3_sim_bringup', 'multi_tb3.launch'],
+                          env=dict(os.environ, TURTLEBOT3_MODEL='burger'))
+    root = ElementTree.parse(os.path.join(REPO, 'launch', 'multi_tb3.launch')).getroot()
+    defaults = {arg.get('name'): arg.get('default') for arg in root.findall('arg')}
+    assert defaults['world'] == 'turtlebot3_house'
+    for order, name in enumerate(['first', 'second', 'third']):
+        truth = echo('/tb3_%d/base_pose_ground_truth' % order, sim)
+        while stamp(truth) < REST:
+            truth = echo('/tb3_%d/base_pose_ground_truth' % order, sim)
+        position, orientation = truth['pose']['pose']['position'], truth['pose']['pose']['orientation']
+        yaw = 2.0 * math.atan2(orientation['z'], orientation['w'])
+        x, y, heading = (float(defaults['%s_tb3_%s' % (name, key)]) for key in ('x_pos', 'y_pos', 'yaw'))
+        print('MEASURED multi_tb3.launch tb3_%d: (x, y, yaw) = (%.4f, %.4f, %.4f), spawn (%.2f, %.2f, %.2f)'
+              % (order, position['x'], position['y'], yaw, x, y, heading))
+        assert math.hypot(position['x'] - x, position['y'] - y) <= AT_SPAWN
+        assert abs(yaw - heading) <= 0.01
+    assert sim.running(), sim.describe()

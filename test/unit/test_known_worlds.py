@@ -40,7 +40,7 @@ SETTLE = 0.5                   # sim s before the scan is read
 def launch_defaults(repo, launch):
     """{argument: default} of a launch file."""
     root = ElementTree.parse(str(repo / 'launch' / launch)).getroot()
-    return {arg.get('name'): arg.get('default') for arg in root.iter('arg')}
+    return {arg.get('name'): arg.get('default') for arg in root.findall('arg')}  # its own, not its includes'
 
 
 def spawn_of(repo, launch):
@@ -83,6 +83,16 @@ def test_the_world_loads_and_names_every_obstacle_once(launch, repo, worlds_fold
 def test_the_launch_spawn_pose_is_free_for_each_model(launch, model, repo, worlds_folder, make):
     world, (x, y, z) = spawn_of(repo, launch)
     make([('', (x, y, z, 0.0))], load_world(world, str(worlds_folder)).obstacles, model)  # no ValueError
+
+
+def test_multi_tb3_launch_starts_as_robotis_multi_turtlebot3_launch(repo):
+    defaults = launch_defaults(repo, 'multi_tb3.launch')
+    assert defaults['world'] == 'turtlebot3_house'
+    for order, name in enumerate(['first', 'second', 'third']):
+        robot = 'tb3_%d' % order
+        assert defaults[name + '_tb3'] == robot
+        assert tuple(float(defaults['%s_tb3_%s' % (name, key)]) for key in ('x_pos', 'y_pos', 'yaw')) == \
+            HOUSE_MULTI_POSES[robot]
 
 
 def test_robotis_three_robot_poses_in_the_house_are_free_together(worlds_folder, make):
