@@ -61,8 +61,9 @@ COLOUR_TOLERANCE = 12     # per channel, for the exact colours below
 # robot_description parameter does not exist turns red in the panel and
 # prints nothing), so reading rviz's output alone would miss it. The panel's
 # pixels are the one reliable source: the left dock (everything left of the 3D
-# view) must hold none of the two status colours, and must hold the OK blue,
-# or we would be looking at the wrong place. rviz's output is checked as
+# view) must hold none of the two status colours in the names' column (the
+# MarkerArray display's icon has red dots of its own), and must hold the OK
+# blue, or we would be looking at the wrong place. rviz's output is checked as
 # well, for [ERROR] lines (a plugin's ROS_ERROR, a bad URDF).
 ERROR_COLOURS = {'Error': (192, 32, 32), 'Warn': (192, 128, 0)}
 OK_NAME_COLOUR = (40, 120, 197)
@@ -142,7 +143,11 @@ class Frame(object):
         return green_pixels(self.panel)
 
     def status_pixels(self):
-        return dict((name, int(near(self.panel, colour).sum())) for name, colour in ERROR_COLOURS.items())
+        """Pixels of the status colours in the column of the display names (where the OK
+        names' blue starts), not in the icons left of it: a MarkerArray's icon has red dots."""
+        columns = numpy.nonzero(near(self.panel, OK_NAME_COLOUR).any(axis=0))[0]
+        names = self.panel[:, columns.min():] if len(columns) else self.panel
+        return dict((name, int(near(names, colour).sum())) for name, colour in ERROR_COLOURS.items())
 
     def ok_name_pixels(self):
         return int(near(self.panel, OK_NAME_COLOUR).sum())
