@@ -1,6 +1,7 @@
 # make test (run with bash, inside `source setup.bash`): the unit tests
-# (pytest, no master), catkin_lint, then each integration test with rostest,
-# which starts its own master on a free port. Exit status: 0 only if all pass.
+# (pytest, no master), catkin_lint, the system tests, then the integration
+# tests with catkin_make run_tests (rostest starts a master of its own on a free
+# port for each). Exit status: 0 only if all pass.
 # Each part's output is shown as it runs and kept; the lines that say why a
 # part failed are repeated at the end, where a CI log's tail shows them.
 set -uo pipefail
@@ -23,7 +24,7 @@ run() {
 # line of each traceback, the soak's missed rows.
 why() {
   { grep -E -A1 '\]\[(FAILURE|ERROR)\]' "$1"
-    grep -E '^(FAILED|ERROR) |(Error|Exception)(: |$)|  MISSED$|FAILED: ' "$1"
+    grep -E '^(FAILED|ERROR) |(Error|Exception)(: |$)|  MISSED$|FAILED: |^Summary: ' "$1"
   } | grep -v '^--$' | awk '!seen[$0]++' | head -40
 }
 
@@ -47,13 +48,13 @@ for test_file in test/system/test_*.py; do
   run "$name" python3 -m pytest -q -p no:cacheprovider "$test_file"
 done
 
-for test_file in test/*.test; do
-  name=$(basename "$test_file")
-  echo "== rostest tb3_sim_nav $name"
-  # Not --text: with it rostest exits 0 even when a test fails. SIGINT first on
-  # a time-out: rostest then stops every node it started.
-  run "$name" timeout --signal=INT --kill-after=20 600 rostest tb3_sim_nav "$name"
-done
+# The rostests (test/*.test) the ROS way, as the README shows, in make setup's
+# workspace: one at a time (CMakeLists.txt), each with a master of its own.
+# catkin_make run_tests exits 0 whatever the tests say; catkin_test_results
+# tells. SIGINT first on a time-out: rostest then stops every node it started.
+echo "== rostests: catkin_make run_tests in .ws"
+run rostests bash -c 'cd .ws && timeout --signal=INT --kill-after=60 3600 catkin_make run_tests &&
+  catkin_test_results build/test_results'
 
 if [ "${1:-}" != --integration-only ]; then
   echo "== short soak: 120 s of sim time under random and hostile commands"
