@@ -6,10 +6,12 @@
 _tb3_root="$(cd "$(dirname "${BASH_SOURCE[0]:-$0}")" && pwd)"
 if [ -f "$_tb3_root/.ws/devel/setup.bash" ]; then
   source "$_tb3_root/.ws/devel/setup.bash"
-  case ":$PATH:" in
-    *":$_tb3_root/.venv/bin:"*) ;;
-    *) export PATH="$_tb3_root/.venv/bin:$PATH" ;;
-  esac
+  # The venv first, also when it is on PATH already behind another python.
+  _tb3_path=":$PATH:"
+  _tb3_path="${_tb3_path//:$_tb3_root\/.venv\/bin:/:}"
+  _tb3_path="${_tb3_path#:}"
+  export PATH="$_tb3_root/.venv/bin:${_tb3_path%:}"
+  unset _tb3_path
   # ROS_HOSTNAME wins over ROS_IP: set it only if neither is set.
   [ -n "${ROS_HOSTNAME:-}${ROS_IP:-}" ] || export ROS_HOSTNAME=localhost
   export ROS_MASTER_URI="${ROS_MASTER_URI:-http://localhost:11311}"
