@@ -27,6 +27,8 @@ import pytest
 from tb3_system_utils import harness, run, wait_until
 
 TELEOP = ['rosrun', 'tb3_sim_nav', 'tb3_teleop_key']
+MULTI = ['roslaunch', 'tb3_sim_bringup', 'multi_tb3.launch']
+NAMESPACED = 'ROS_NAMESPACE=tb3_0 rosrun tb3_sim_nav tb3_teleop_key'  # the README's, for one of several
 LIMITS = {'burger': (0.22, 2.84), 'waffle': (0.26, 1.82), 'waffle_pi': (0.26, 1.82)}
 LINEAR_HALF_STEP = 0.005   # m/s: the profile's change per message
 ANGULAR_HALF_STEP = 0.05   # rad/s
@@ -377,3 +379,28 @@ def test_roslaunch_gives_the_node_the_terminal(master, processes, tmp_path, monk
     assert stopped, 'the last cmd_vel is %s' % (last(twists(cmd_vel)),)
     assert 'Stopped' in launch.output(), launch.output()[-2000:]
     assert launch.settings() == launch.settings_before
+
+
+def test_in_a_namespace_it_drives_one_robot_of_three(master, processes, tmp_path, monkeypatch):
+    """multi_tb3.launch, then the README's `ROS_NAMESPACE=tb3_0 rosrun tb3_sim_nav tb3_teleop_key`:
+    tb3_0 (facing +y) drives ahead on /tb3_0/cmd_vel, tb3_1 does not move."""
+    monkeypatch.setenv('TURTLEBOT3_MODEL', 'burger')
+    sim = processes.start('sim', MULTI)
+    truth = dict((name, Echo(processes, '/%s/base_pose_ground_truth' % name)) for name in ('tb3_0', 'tb3_1'))
+    ready = wait_until(lambda: all(poses(echo) for echo in truth.values()) or not sim.running(), SIM_READY)
+    assert ready and sim.running(), 'no ground truth within %.0f s; %s:\n%s' % (
+        SIM_READY, sim.log, harness.tail(sim.log))
+    cmd_vel = Echo(processes, '/tb3_0/cmd_vel')
+    teleop = start_teleop(processes, tmp_path, cmd_vel, argv=['bash', '-c', NAMESPACED])
+    start, other = last(poses(truth['tb3_0'])), last(poses(truth['tb3_1']))
+    type_and_see(teleop, 'wwwww', 0.05, 0.0)
+    wait_for_twist(cmd_vel, 0.05, 0.0)
+    assert wait_until(lambda: last(poses(truth['tb3_0']))['y'] - start['y'] > 0.05, REACH_WITHIN), \
+        'tb3_0 did not drive 5 cm ahead: %s -> %s' % (start, last(poses(truth['tb3_0'])))
+    now, other_now = last(poses(truth['tb3_0'])), last(poses(truth['tb3_1']))
+    print('MEASURED namespaced teleop: tb3_0 (%.3f, %.3f) -> (%.3f, %.3f); tb3_1 moved %.5f m'
+          % (start['x'], start['y'], now['x'], now['y'],
+             math.hypot(other_now['x'] - other['x'], other_now['y'] - other['y'])))
+    assert abs(now['x'] - start['x']) < 0.01  # ahead is +y for tb3_0 (yaw 1.57)
+    assert math.hypot(other_now['x'] - other['x'], other_now['y'] - other['y']) < 1e-3
+    type_and_see(teleop, 's', 0.0, 0.0)

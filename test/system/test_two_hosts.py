@@ -6,22 +6,22 @@ B`, joined by a veth pair with private addresses of its own (10.233.N.1 and
 network; every process runs in one of them with `ip netns exec`, in a bash
 that sources setup.bash, as a user's terminal on that computer would.
 
-1. As the README's security section says, host A exports ROS_IP (its own
+1. As doc/network.md says, host A exports ROS_IP (its own
    address) and ROS_MASTER_URI (its master), host B exports its own ROS_IP
-   and A's ROS_MASTER_URI, and each applies the README's firewall block
+   and A's ROS_MASTER_URI, and each applies doc/network.md's firewall block
    trusting the other. odom_out_and_back.py on B drives the robot of A
    across the link (not waited for by lockstep: that follows local nodes
    only) and must end as the tutorial test has it: within 5 cm and 5 deg of
    where it started, after about 1 m ahead and 360 deg of turning in all.
-2. What a stranger on the network reaches: host A as the README sets up
+2. What a stranger on the network reaches: host A as doc/network.md sets up
    one machine (setup.bash: ROS_HOSTNAME=localhost, the master on
    localhost). Each TCP port listening in A is tried from B. The master, the
    simulator and every TCPROS port listen on loopback only and refuse; the
    XML-RPC APIs of Debian's roscpp nodes (rosout, robot_state_publisher)
    listen on every interface whatever ROS_HOSTNAME says: B reaches them,
-   asks their PID and stops robot_state_publisher. With the README's
+   asks their PID and stops robot_state_publisher. With doc/network.md's
    firewall block (trusting no one) applied in A, B reaches nothing. The
-   test asserts exactly this, so the README's table stays true.
+   test asserts exactly this, so doc/network.md's table stays true.
 """
 import math
 import os
@@ -39,19 +39,19 @@ SUBNET = '10.233.%d' % (os.getpid() % 200 + 20)
 ADDRESS = {'a': SUBNET + '.1', 'b': SUBNET + '.2'}
 LOOPBACK_ONLY = ('rosmaster', 'tb3_sim_node')      # our own: python, bound to loopback
 ROSCPP = ('rosout', 'robot_state_pub')            # Debian's roscpp (ss shows 15 characters)
-README_TRUSTED = '192.168.1.20'                   # the other machine, in the README's firewall block
+DOC_TRUSTED = '192.168.1.20'                   # the other machine, in doc/network.md's firewall block
 
 
 def readme_firewall(trusted=None):
-    """The README's firewall block (nft rules), trusting `trusted` or no one."""
-    with open(os.path.join(REPO, 'README.md')) as readme:
-        text = readme.read()
+    """doc/network.md's firewall block (nft rules), trusting `trusted` or no one."""
+    with open(os.path.join(REPO, 'doc', 'network.md')) as page:
+        text = page.read()
     block = text.split('<!-- firewall: test/system/test_two_hosts.py runs this block -->\n')[1]
     lines = [line[4:] for line in block.split('\n')]
     rules = '\n'.join(lines[lines.index("sudo nft -f - <<'EOF'") + 1:lines.index('EOF')])
     if trusted is None:
-        return '\n'.join(line for line in rules.split('\n') if README_TRUSTED not in line)
-    return rules.replace(README_TRUSTED, trusted)
+        return '\n'.join(line for line in rules.split('\n') if DOC_TRUSTED not in line)
+    return rules.replace(DOC_TRUSTED, trusted)
 
 
 def ip(*args):
@@ -93,7 +93,7 @@ class Hosts(object):
                               stderr=subprocess.STDOUT, universal_newlines=True, timeout=timeout)
 
     def firewall(self, host, rules):
-        """`rules` applied with nft on `host`, as the README's block does."""
+        """`rules` applied with nft on `host`, as doc/network.md's block does."""
         subprocess.run(['ip', 'netns', 'exec', self.names[host], 'nft', '-f', '-'], input=rules,
                        universal_newlines=True, check=True)
 
@@ -227,7 +227,7 @@ def test_what_a_stranger_reaches_on_a_machine_set_up_as_the_readme_says(hosts, p
           % (sorted(ports), sorted((port, name) for _, port, name in ports if port in reached)))
     everywhere = [(port, name) for address, port, name in ports if not address.startswith('127.')]
     assert sorted(name for _, name in everywhere) == sorted(ROSCPP), \
-        'what listens on every interface changed: %s: update the README' % everywhere
+        'what listens on every interface changed: %s: update doc/network.md' % everywhere
     assert reached == set(port for port, _ in everywhere)
     # Each is a node's XML-RPC API: it tells its PID, and obeys shutdown, to anyone.
     for port, name in everywhere:
@@ -239,6 +239,6 @@ def test_what_a_stranger_reaches_on_a_machine_set_up_as_the_readme_says(hosts, p
     hosts.firewall('a', readme_firewall())
     still = [(address, port, name) for address, port, name in listening(hosts)]
     assert not reachable_from_b(hosts, [port for _, port, _ in still]), \
-        'the README\'s firewall leaves ports open: %s' % still
+        'doc/network.md\'s firewall leaves ports open: %s' % still
     assert hosts.run('a', 'rostopic echo -n 1 /odom/header', timeout=60.0, **local).returncode == 0, \
         'with the firewall, the machine itself no longer reads the simulator'

@@ -12,7 +12,6 @@ Burger) are in the ray cast: pieces above doors and table tops pass over
 the beams, low ones under them.
 """
 import math
-import os
 import xml.etree.ElementTree as ElementTree
 
 import numpy as np
