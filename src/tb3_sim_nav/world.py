@@ -28,7 +28,8 @@ GRAVITY = 9.81           # m/s^2
 GROUND_FRICTION = 1.0    # rubber tyre on a hard floor
 GROUND_COLOR = (0.72, 0.70, 0.66, 1.0)  # a light grey floor, for cameras
 GROUND_SIZE = 100.0      # m, the ground's visual square
-BODY_FRICTION = 0.3      # plastic plates against a wall
+BODY_FRICTION = 0.2      # plastic plates against a wall; at 0.3 a robot pushing a wall at an angle stick-slips (doc/design.md)
+SOLVER_ITERATIONS = 100  # Bullet's default 50 lets stopped wheels creep (0.1 mm/s, 0.6 deg/min)
 STATIC_BODIES = 2        # Bullet's collision group of bodies with mass 0
 GROUND = 'ground_plane'  # Gazebo's name for it
 SHAPE_COLOR = (0.75, 0.75, 0.72, 1.0)  # a shape with no colour of its own
@@ -65,6 +66,7 @@ class World(object):
             pybullet.configureDebugVisualizer(pybullet.COV_ENABLE_RENDERING, 0, **self._call)
         self.set_gravity((0.0, 0.0, -GRAVITY))
         self.set_time_step(time_step)
+        pybullet.setPhysicsEngineParameter(numSolverIterations=SOLVER_ITERATIONS, **self._call)
         plane_shape = pybullet.createCollisionShape(pybullet.GEOM_PLANE, **self._call)
         ground = pybullet.createVisualShape(pybullet.GEOM_BOX, halfExtents=[GROUND_SIZE / 2, GROUND_SIZE / 2, 0.0005],
                                             visualFramePosition=[0, 0, -0.0005], rgbaColor=GROUND_COLOR, **self._call)
@@ -375,19 +377,11 @@ class RobotBody(object):
         self.links = links
         self.base_link = pybullet.getBodyInfo(self.id, **self._call)[0].decode()
         self.wheels = [links[LEFT_WHEEL_JOINT], links[RIGHT_WHEEL_JOINT]]
-        # Bullet multiplies the two bodies' coefficients: the plane's is 1, so
-        # these are the coefficients of wheel and caster on the ground.
-        for wheel in self.wheels:
-            pybullet.changeDynamics(self.id, wheel, lateralFriction=ground_friction,
-                                    rollingFriction=0.0, spinningFriction=0.0, **self._call)
-        caster_links = [links[name] for name in casters if name in links]
+        self.casters = [links[name] for name in casters if name in links]
         # The plastic body slides along a wall rather than gripping it.
-        for link in set([-1] + list(links.values())) - set(self.wheels) - set(caster_links):
+        for link in set([-1] + list(links.values())) - set(self.wheels) - set(self.casters):
             pybullet.changeDynamics(self.id, link, lateralFriction=BODY_FRICTION, **self._call)
-        # With no friction a ball caster carries weight but never steers the robot.
-        for link in caster_links:
-            pybullet.changeDynamics(self.id, link, lateralFriction=caster_friction,
-                                    rollingFriction=0.0, spinningFriction=0.0, **self._call)
+        self.set_friction(ground_friction, caster_friction)
         for link in set([-1] + list(links.values())):
             pybullet.setCollisionFilterGroupMask(self.id, link, _int32(group), -1, **self._call)
         self.radius = _bounding_radius(world.client, self.id, [-1] + sorted(set(links.values())))
@@ -415,21 +409,24 @@ class RobotBody(object):
     def remove(self):
         pybullet.removeBody(self.id, **self._call)
 
-    def set_wheel_speeds(self, left, right):
-        """Target angular speeds (rad/s) of the wheel motors.
+    def set_friction(self, ground, caster):
+        """Coulomb friction of the wheels and of the ball casters on the ground. Bullet
+        multiplies the two bodies' coefficients, and the ground's is 1. With no
+        friction a ball caster carries weight but never steers the robot."""
+        for links, friction in ((self.wheels, ground), (self.casters, caster)):
+            for link in links:
+                pybullet.changeDynamics(self.id, link, lateralFriction=friction, rollingFriction=0.0,
+                                        spinningFriction=0.0, **self._call)
 
-        A motor told to stop holds its wheel's angle, as a servo does: a zero
-        velocity target alone lets Bullet's iterative solver creep under load.
-        """
-        torques = [self.wheel_torque] * 2
-        if left == 0.0 and right == 0.0:
-            pybullet.setJointMotorControlArray(
-                self.id, self.wheels, pybullet.POSITION_CONTROL,
-                targetPositions=self.wheel_states()[0], forces=torques, **self._call)
-        else:
-            pybullet.setJointMotorControlArray(
-                self.id, self.wheels, pybullet.VELOCITY_CONTROL,
-                targetVelocities=[left, right], forces=torques, **self._call)
+    def set_wheel_speeds(self, left, right):
+        """Target angular speeds (rad/s) of the wheel motors, each a velocity servo
+        with the motor's torque, as Gazebo's diff drive and a Dynamixel in velocity
+        mode are. A stopped motor is a servo at speed 0: holding the wheel's angle
+        instead fights the contacts' friction and can spin a stopped robot up
+        (doc/design.md, "Still means still")."""
+        pybullet.setJointMotorControlArray(
+            self.id, self.wheels, pybullet.VELOCITY_CONTROL,
+            targetVelocities=[left, right], forces=[self.wheel_torque] * 2, **self._call)
 
     def reset(self, pose):
         """Put the robot at `pose` (x, y, z, yaw), at rest, wheels at angle 0."""
