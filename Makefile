@@ -25,7 +25,7 @@ $(VENV)/.ready: tools/requirements.txt
 # does not look for packages inside a package.
 # catkin_make again whenever what it generates from could have changed.
 GAZEBO_MSGS := gazebo_msgs/CMakeLists.txt gazebo_msgs/package.xml $(wildcard gazebo_msgs/msg/* gazebo_msgs/srv/*)
-$(WS)/devel/.ready: CMakeLists.txt package.xml setup.py env-hooks/* $(wildcard scripts/*) $(wildcard test/*.test) $(GAZEBO_MSGS) | $(VENV)/.ready
+$(WS)/devel/.ready: CMakeLists.txt package.xml setup.py env-hooks/* $(wildcard cfg/*) $(wildcard scripts/*) $(wildcard test/*.test) $(GAZEBO_MSGS) | $(VENV)/.ready
 	[ ! -L $(WS)/src/tb3_sim_nav ] || rm $(WS)/src/tb3_sim_nav
 	mkdir -p $(WS)/src/tb3_sim_nav
 	find $(WS)/src/tb3_sim_nav -maxdepth 1 -type l -delete

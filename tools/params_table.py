@@ -25,7 +25,8 @@ def main():
             default = '(none)'
         else:
             default = shown(parameter.default)
-        print('| `~%s` | %s | %s | %s |' % (parameter.name, default, parameter.unit, parameter.doc))
+        live = ' (live: `dynparam set`)' if parameter.live else ''
+        print('| `~%s` | %s | %s | %s%s |' % (parameter.name, default, parameter.unit, parameter.doc, live))
 
 
 if __name__ == '__main__':

@@ -72,12 +72,16 @@ class EncoderOdometry(object):
     """Dead reckoning from wheel angles, as the TurtleBot3 firmware does it.
 
     Each update takes the total wheel angles (rad) and integrates the step
-    with the heading at its midpoint (second-order Runge-Kutta).
+    with the heading at its midpoint (second-order Runge-Kutta). A base
+    controller's calibration multiplies each step's distance by
+    `linear_scale` and its turn by `angular_scale`.
     """
 
-    def __init__(self, wheel_radius, wheel_separation, x=0.0, y=0.0, yaw=0.0):
+    def __init__(self, wheel_radius, wheel_separation, x=0.0, y=0.0, yaw=0.0, linear_scale=1.0,
+                 angular_scale=1.0):
         self.wheel_radius = wheel_radius
         self.wheel_separation = wheel_separation
+        self.linear_scale, self.angular_scale = linear_scale, angular_scale
         self.reset(x, y, yaw)
 
     def reset(self, x=0.0, y=0.0, yaw=0.0):
@@ -90,9 +94,15 @@ class EncoderOdometry(object):
             right_delta = right_angle - self._last_angles[1]
             distance, turn = body_twist(left_delta, right_delta,
                                         self.wheel_radius, self.wheel_separation)
+            distance, turn = distance * self.linear_scale, turn * self.angular_scale
             heading = self.yaw + turn / 2.0
             self.x += distance * math.cos(heading)
             self.y += distance * math.sin(heading)
             self.yaw = wrap_angle(self.yaw + turn)
         self._last_angles = (left_angle, right_angle)
         return self.x, self.y, self.yaw
+
+    def twist(self, left_speed, right_speed):
+        """Body speeds (v, w) these encoders read from wheel speeds (rad/s), scaled as the steps are."""
+        v, w = body_twist(left_speed, right_speed, self.wheel_radius, self.wheel_separation)
+        return v * self.linear_scale, w * self.angular_scale

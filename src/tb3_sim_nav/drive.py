@@ -12,14 +12,18 @@ class Drive(object):
 
     def __init__(self, geometry, wheel_acceleration=1.0, cmd_vel_timeout=0.0, motor_errors=(0.0, 0.0)):
         self.geometry = geometry
-        self.cmd_vel_timeout_ns = cmd_vel_timeout * 1e9
-        self.motor_errors = motor_errors
-        # rad/s per second of a wheel whose rim may gain `wheel_acceleration` m/s per second
-        self.wheel_acceleration = wheel_acceleration / geometry.wheel_radius
+        self.configure(wheel_acceleration, cmd_vel_timeout, motor_errors)
         self.reset()
 
+    def configure(self, wheel_acceleration, cmd_vel_timeout, motor_errors):
+        """The knobs, at start-up or while running (the next step uses them)."""
+        self.cmd_vel_timeout_ns = cmd_vel_timeout * 1e9
+        self.motor_errors = tuple(motor_errors)
+        # rad/s per second of a wheel whose rim may gain `wheel_acceleration` m/s per second
+        self.wheel_acceleration = wheel_acceleration / self.geometry.wheel_radius
+
     def reset(self):
-        self._target = (0.0, 0.0)     # wheel speeds asked for (rad/s)
+        self._target = (0.0, 0.0)     # wheel speeds asked for (rad/s), before the motors' errors
         self.speeds = (0.0, 0.0)      # wheel speeds the motors are set to
         self._last_command_ns = None
 
@@ -29,13 +33,12 @@ class Drive(object):
         The motors reach their speed only to within their errors: timing
         alone cannot know that, encoders can.
         """
-        left, right = wheel_speeds(v, w, *self.geometry)
-        self._target = (left * (1.0 + self.motor_errors[0]), right * (1.0 + self.motor_errors[1]))
+        self._target = wheel_speeds(v, w, *self.geometry)
         self._last_command_ns = now_ns
 
     def step(self, now_ns, step_s):
         """The wheel speeds for the step from `now_ns`: timeout and acceleration limit applied."""
-        target = self._target
+        target = tuple(speed * (1.0 + error) for speed, error in zip(self._target, self.motor_errors))
         if (self.cmd_vel_timeout_ns > 0.0 and self._last_command_ns is not None
                 and now_ns - self._last_command_ns > self.cmd_vel_timeout_ns):
             target = (0.0, 0.0)

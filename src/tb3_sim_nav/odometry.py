@@ -2,7 +2,8 @@
 
 Both answer `read(truth)` with (pose, twist) given the true ones, so the
 truth is read off the world once per publication; `update()` runs after
-every physics step and `reset(x, y, yaw)` after a reset.
+every physics step, `reset(x, y, yaw)` after a reset, and `configure(config)`
+when the knobs change.
 """
 import math
 
@@ -12,7 +13,10 @@ from .diff_drive import EncoderOdometry
 
 
 class WorldOdometry(object):
-    """Gazebo's TurtleBot3 odometry: the true pose and twist, no drift."""
+    """Gazebo's TurtleBot3 odometry: the true pose and twist, no drift (and nothing to calibrate)."""
+
+    def configure(self, config):
+        pass
 
     def update(self):
         pass
@@ -29,12 +33,21 @@ class WheelOdometry(object):
     step. It believes in wheels that may differ from the real ones by the
     calibration errors, and reads the encoders with Gaussian noise."""
 
-    def __init__(self, body, geometry, radius_error=0.0, separation_error=0.0, noise=0.0, rng=None):
+    def __init__(self, body, geometry, config, rng=None):
         self.body = body
-        self.noise = noise
+        self.geometry = geometry
         self.rng = rng if rng is not None else np.random.default_rng()
-        self.encoders = EncoderOdometry(geometry.wheel_radius * (1.0 + radius_error),
-                                        geometry.wheel_separation * (1.0 + separation_error))
+        self.encoders = EncoderOdometry(geometry.wheel_radius, geometry.wheel_separation)
+        self.configure(config)
+
+    def configure(self, config):
+        """The wheels it believes in, its noise and its calibration, from a params.Config."""
+        self.noise = config.encoder_noise
+        encoders = self.encoders
+        encoders.wheel_radius = self.geometry.wheel_radius * (1.0 + config.odom_wheel_radius_error)
+        encoders.wheel_separation = self.geometry.wheel_separation * (1.0 + config.odom_wheel_separation_error)
+        encoders.linear_scale = config.odom_linear_scale_correction
+        encoders.angular_scale = config.odom_angular_scale_correction
 
     def update(self):
         angles, _ = self.body.wheel_states()
@@ -48,9 +61,7 @@ class WheelOdometry(object):
     def read(self, truth=None):
         encoders = self.encoders
         _, speeds = self.body.wheel_states()
-        radius, separation = encoders.wheel_radius, encoders.wheel_separation
+        v, w = encoders.twist(*speeds)
         pose = ((encoders.x, encoders.y, 0.0),
                 (0.0, 0.0, math.sin(encoders.yaw / 2.0), math.cos(encoders.yaw / 2.0)))
-        twist = ((radius * (speeds[0] + speeds[1]) / 2.0, 0.0, 0.0),
-                 (0.0, 0.0, radius * (speeds[1] - speeds[0]) / separation))
-        return pose, twist
+        return pose, ((v, 0.0, 0.0), (0.0, 0.0, w))

@@ -16,7 +16,7 @@ from typing import Optional
 from .robot_model import model_problem
 from .world_file import WorldError, parse_robots
 
-Parameter = namedtuple('Parameter', 'name default kind check unit doc origin')
+Parameter = namedtuple('Parameter', 'name default kind check unit doc origin live')
 
 #: Where a default comes from when the field's default is None.
 FROM_PROFILE, FROM_MODEL = 'profile', 'model'
@@ -36,6 +36,10 @@ def _non_negative(value):
 
 def _fraction(value):
     return None if -0.5 < value < 0.5 else 'must be between -0.5 and 0.5'
+
+
+def _correction(value):
+    return None if 0.5 <= value <= 2.0 else 'must be between 0.5 and 2.0 (a factor near 1)'
 
 
 def _frame_id(value):
@@ -97,8 +101,10 @@ PROFILES = {
 }
 
 
-def _p(default, doc, check=None, unit='', origin=None):
-    return dataclasses.field(default=default, metadata=dict(check=check, unit=unit, doc=doc, origin=origin))
+def _p(default, doc, check=None, unit='', origin=None, live=False):
+    """A field of Config; `live`: it may change while the simulator runs (dynamic_reconfigure)."""
+    return dataclasses.field(default=default, metadata=dict(check=check, unit=unit, doc=doc, origin=origin,
+                                                            live=live))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -123,7 +129,7 @@ class Config(object):
     max_linear_speed: Optional[float] = _p(None, "commands beyond this are clamped; unset: the model's, from its URDF's <drive_limits> (burger 0.22, waffle and waffle_pi 0.26)", _positive, 'm/s', FROM_MODEL)
     max_angular_speed: Optional[float] = _p(None, "the same for turning (burger 2.84, waffle and waffle_pi 1.82)", _positive, 'rad/s', FROM_MODEL)
     wheel_torque: float = _p(1.5, 'stall torque of each wheel motor (Dynamixel XL430 at 12 V)', _positive, 'N m')
-    wheel_acceleration: float = _p(1.0, "limit on each wheel rim's acceleration, as TurtleBot3's Gazebo set-up (wheelAcceleration 1); 0 = none", _non_negative, 'm/s^2')
+    wheel_acceleration: float = _p(1.0, "limit on each wheel rim's acceleration, as TurtleBot3's Gazebo set-up (wheelAcceleration 1); 0 = none", _non_negative, 'm/s^2', live=True)
     odom_frame: str = _p('odom', 'frame of odom and of its tf parent (a robot with a name gets it as a prefix: tb3_0/odom)', _frame_id)
     base_frame: str = _p('base_footprint', 'child frame of odom and its tf (prefixed as odom_frame)', _frame_id)
     world_frame: str = _p('world', "the world's frame: the simulator publishes tf from it to each robot's odom frame (the truth: the identity while odom is the true pose, the drift of encoder odometry otherwise) and draws the world's obstacles in it on world_markers; empty: neither (when a localization node publishes odom's parent)", _optional_frame_id)
@@ -133,7 +139,7 @@ class Config(object):
     scan_samples: int = _p(360, 'beams per turn', _at_least(3))
     scan_range_min: float = _p(0.12, 'closer hits read -inf', _non_negative, 'm')
     scan_range_max: float = _p(3.5, 'beams reaching no wall within it read +inf', _positive, 'm')
-    scan_noise: float = _p(0.01, 'standard deviation of Gaussian range noise; 0 = none', _non_negative, 'm')
+    scan_noise: float = _p(0.01, 'standard deviation of Gaussian range noise; 0 = none', _non_negative, 'm', live=True)
     imu: bool = _p(True, 'publish the IMU on imu')
     imu_rate: float = _p(100.0, 'IMU rate (sim time); at most ~physics_rate: the real Burger and its Gazebo model give 200 Hz, with ~physics_rate 200', _positive, 'Hz')
     camera_width: Optional[int] = _p(None, 'image width of the Waffle (Pi) camera; unset: the model\'s, at most 640 (the height follows the model\'s aspect)', _between(1, 4096), 'pixels', FROM_MODEL)
@@ -143,16 +149,18 @@ class Config(object):
     seed: int = _p(-1, 'seed of every noise source; -1 = different each run', _at_least(-1))
     profile: str = _p('gazebo', 'realism profile: chooses the defaults below', _one_of(*sorted(PROFILES)))
     odom_source: str = _p(None, 'odom from the true pose (Gazebo) or integrated from wheel encoders (firmware)', _one_of('world', 'encoders'), origin=FROM_PROFILE)
-    ground_friction: float = _p(None, 'Coulomb friction of wheel on ground', _positive, origin=FROM_PROFILE)
-    caster_friction: float = _p(None, 'Coulomb friction of the ball caster on ground (drags when turning)', _non_negative, origin=FROM_PROFILE)
-    left_motor_error: float = _p(None, 'the left wheel turns this much faster than commanded (negative: slower), as a loaded motor does', _fraction, 'fraction', FROM_PROFILE)
-    right_motor_error: float = _p(None, 'the same for the right wheel', _fraction, 'fraction', FROM_PROFILE)
-    odom_wheel_radius_error: float = _p(None, 'encoder odometry assumes a wheel this much bigger than the real one', _fraction, 'fraction', FROM_PROFILE)
-    odom_wheel_separation_error: float = _p(None, 'encoder odometry assumes wheels this much further apart than they act', _fraction, 'fraction', FROM_PROFILE)
-    encoder_noise: float = _p(None, 'standard deviation of Gaussian noise on each wheel-angle reading', _non_negative, 'rad', FROM_PROFILE)
-    cmd_vel_timeout: float = _p(None, 'stop when no cmd_vel came for this long (firmware: 0.5); 0 = hold the last command forever', _non_negative, 's', FROM_PROFILE)
-    imu_gyro_noise: float = _p(None, 'standard deviation of angular-velocity noise', _non_negative, 'rad/s', FROM_PROFILE)
-    imu_accel_noise: float = _p(None, 'standard deviation of linear-acceleration noise', _non_negative, 'm/s^2', FROM_PROFILE)
+    ground_friction: float = _p(None, 'Coulomb friction of wheel on ground', _positive, origin=FROM_PROFILE, live=True)
+    caster_friction: float = _p(None, 'Coulomb friction of the ball caster on ground (drags when turning)', _non_negative, origin=FROM_PROFILE, live=True)
+    left_motor_error: float = _p(None, 'the left wheel turns this much faster than commanded (negative: slower), as a loaded motor does', _fraction, 'fraction', FROM_PROFILE, live=True)
+    right_motor_error: float = _p(None, 'the same for the right wheel', _fraction, 'fraction', FROM_PROFILE, live=True)
+    odom_wheel_radius_error: float = _p(None, 'encoder odometry assumes a wheel this much bigger than the real one', _fraction, 'fraction', FROM_PROFILE, live=True)
+    odom_wheel_separation_error: float = _p(None, 'encoder odometry assumes wheels this much further apart than they act', _fraction, 'fraction', FROM_PROFILE, live=True)
+    odom_linear_scale_correction: float = _p(1.0, "encoder odometry's distances are multiplied by this, as a base controller's calibration (ROS by Example's calibrate_linear.py measures it); the gazebo profile's odometry is the true pose and ignores it", _correction, 'factor', live=True)
+    odom_angular_scale_correction: float = _p(1.0, "encoder odometry's turns are multiplied by this (calibrate_angular.py)", _correction, 'factor', live=True)
+    encoder_noise: float = _p(None, 'standard deviation of Gaussian noise on each wheel-angle reading', _non_negative, 'rad', FROM_PROFILE, live=True)
+    cmd_vel_timeout: float = _p(None, 'stop when no cmd_vel came for this long (firmware: 0.5); 0 = hold the last command forever', _non_negative, 's', FROM_PROFILE, live=True)
+    imu_gyro_noise: float = _p(None, 'standard deviation of angular-velocity noise', _non_negative, 'rad/s', FROM_PROFILE, live=True)
+    imu_accel_noise: float = _p(None, 'standard deviation of linear-acceleration noise', _non_negative, 'm/s^2', FROM_PROFILE, live=True)
 
     def replace(self, **changes):
         """A copy with `changes` (unchecked: for tests and tools)."""
@@ -165,8 +173,10 @@ def _kind(field):
 
 #: The parameters in the node's order, for the README table and the tests.
 PARAMETERS = [Parameter(field.name, field.default, _kind(field), field.metadata['check'], field.metadata['unit'],
-                        field.metadata['doc'], field.metadata['origin'])
+                        field.metadata['doc'], field.metadata['origin'], field.metadata['live'])
               for field in dataclasses.fields(Config)]
+#: Those that may change while the simulator runs.
+LIVE = [parameter for parameter in PARAMETERS if parameter.live]
 
 
 def _typed(parameter, value):
@@ -187,6 +197,27 @@ def _typed(parameter, value):
                             ' finite' if kind is float else '', kind.__name__))
 
 
+def check(parameter, value):
+    """`value` typed and checked for `parameter`, or ParameterError saying why."""
+    value = _typed(parameter, value)
+    problem = parameter.check(value) if parameter.check and value is not None else None
+    if problem:
+        raise ParameterError('parameter ~%s = %r: %s' % (parameter.name, value, problem))
+    return value
+
+
+def changed(config, changes):
+    """`config` with `changes` {name: value} of LIVE parameters, each checked; ParameterError
+    (and nothing changed) if any is not live or not valid."""
+    live = dict((parameter.name, parameter) for parameter in LIVE)
+    typed = {}
+    for name, value in changes.items():
+        if name not in live:
+            raise ParameterError('parameter ~%s cannot change while the simulator runs' % name)
+        typed[name] = check(live[name], value)
+    return config.replace(**typed)
+
+
 def resolve(lookup, parameters=PARAMETERS):
     """Every parameter, checked: a Config."""
     resolved = {}
@@ -194,11 +225,7 @@ def resolve(lookup, parameters=PARAMETERS):
         default = parameter.default
         if parameter.origin == FROM_PROFILE:
             default = PROFILES[resolved['profile']][parameter.name]
-        value = _typed(parameter, lookup(parameter.name, default))
-        problem = parameter.check(value) if parameter.check and value is not None else None
-        if problem:
-            raise ParameterError('parameter ~%s = %r: %s' % (parameter.name, value, problem))
-        resolved[parameter.name] = value
+        resolved[parameter.name] = check(parameter, lookup(parameter.name, default))
     for rate in ('odom_rate', 'joint_states_rate', 'scan_rate', 'imu_rate', 'camera_rate'):
         if resolved[rate] is not None and resolved[rate] > resolved['physics_rate']:
             raise ParameterError('parameter ~%s = %r: must not exceed ~physics_rate = %r'

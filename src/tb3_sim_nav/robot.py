@@ -22,13 +22,11 @@ class Robot(object):
         self.spawn_pose = spawn_pose
         self.limits = Limits(config.max_linear_speed or model.limits.max_linear,
                              config.max_angular_speed or model.limits.max_angular)
-        self.drive = Drive(model.geometry, config.wheel_acceleration, config.cmd_vel_timeout,
-                           (config.left_motor_error, config.right_motor_error))
+        self.drive = Drive(model.geometry)
         if config.odom_source == 'world':
             self.odometry_source = WorldOdometry()
         else:
-            self.odometry_source = WheelOdometry(body, model.geometry, config.odom_wheel_radius_error,
-                                                 config.odom_wheel_separation_error, config.encoder_noise, rng)
+            self.odometry_source = WheelOdometry(body, model.geometry, config, rng)
         self.lidar = Lidar(body, LIDAR_LINK, config.scan_samples, config.scan_range_min, config.scan_range_max,
                            config.scan_noise, rng) if config.scan else None
         self.imu = Imu(body, config.imu_gyro_noise, config.imu_accel_noise, rng) if config.imu else None
@@ -36,7 +34,19 @@ class Robot(object):
                                horizontal_fov=config.camera_horizontal_fov or spec.horizontal_fov,
                                rate=config.camera_rate or min(spec.rate, DEFAULT_MAX_RATE))
                         for spec in model.cameras]
+        self.configure(config)
         self.reset()
+
+    def configure(self, config):
+        """The realism knobs of a params.Config, at start-up or while running."""
+        self.drive.configure(config.wheel_acceleration, config.cmd_vel_timeout,
+                             (config.left_motor_error, config.right_motor_error))
+        self.odometry_source.configure(config)
+        self.body.set_friction(config.ground_friction, config.caster_friction)
+        if self.lidar:
+            self.lidar.noise_stddev = config.scan_noise
+        if self.imu:
+            self.imu.gyro_noise, self.imu.accel_noise = config.imu_gyro_noise, config.imu_accel_noise
 
     # --- commands and stepping ------------------------------------------------
     def command(self, v, w, now_ns):

@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 from .frames import IDENTITY, compose, inverse, normalized, relative, rotate
+from .params import changed
 from .robot import Robot
 from .world import GROUND, World
 
@@ -53,6 +54,14 @@ class Simulation(object):
         robot = self.robots[name] = Robot(name, model, body, config, tuple(pose), rng)
         robot.model_name = model_name
         return robot
+
+    def reconfigure(self, changes):
+        """Live parameters {name: value} changed for every robot from the next step on;
+        params.ParameterError (nothing changed) if one cannot change or is not valid."""
+        self.config = changed(self.config, changes)
+        for robot in self.robots.values():
+            robot.configure(self.config)
+        return self.config
 
     def remove_robot(self, name):
         self.world.remove_robot(self.robots.pop(name).body)

@@ -300,3 +300,46 @@ def test_odometry_given_the_truth_is_the_truth_in_the_gazebo_profile_and_encoder
     assert sim.odometry(truth) is truth
     realistic = make_sim(profile='realistic', seed=1)
     assert realistic.odometry(truth) == (realistic.odometry_pose(), realistic.odometry_twist())
+
+
+# --- live parameters (dynamic_reconfigure) --------------------------------------------
+
+def test_odometry_corrections_scale_encoder_odometry_by_their_factor(make_sim):
+    """The same run (same seed) with and without a correction: odometry's distance,
+    or its turn, differs by exactly the factor, and the truth not at all."""
+    def drive(**correction):
+        sim = make_sim(profile='realistic', seed=7, **correction)
+        run(sim, 3.0, (0.2, 0.0))
+        run(sim, 1.0, (0.0, 0.0))
+        after_straight = pose(sim.odometry_pose())
+        run(sim, 1.0, (0.0, 1.0))
+        run(sim, 1.0, (0.0, 0.0))
+        return after_straight, pose(sim.odometry_pose()), pose(sim.true_pose())
+
+    (x, y, yaw), (_, _, yaw_end), truth = drive()
+    (xl, yl, _), _, truth_linear = drive(odom_linear_scale_correction=0.9)
+    (_, _, yaw_a), (_, _, yaw_end_a), truth_angular = drive(odom_angular_scale_correction=1.1)
+    assert math.hypot(x, y) > 0.5
+    assert math.hypot(xl, yl) == pytest.approx(0.9 * math.hypot(x, y), rel=1e-9)
+    assert yaw_a == pytest.approx(1.1 * yaw, rel=1e-9)
+    assert abs(yaw_end - yaw) > 0.5
+    assert yaw_end_a - yaw_a == pytest.approx(1.1 * (yaw_end - yaw), rel=1e-9)
+    assert truth_linear == truth == truth_angular
+
+
+def test_reconfigure_changes_the_running_robot_and_refuses_bad_values(make_sim):
+    from tb3_sim_nav.params import ParameterError
+    sim = make_sim()
+    sim.simulation.reconfigure({'cmd_vel_timeout': 0.3})  # the firmware's timeout, switched on while running
+    sim.command(0.1, 0.0)
+    run(sim, 1.0)
+    assert abs(forward_speed(sim)) < 1e-3  # stopped 0.3 s after the command, not held
+    before = sim.simulation.config
+    for changes, problem in (({'caster_friction': -1.0}, 'must be >= 0'),
+                             ({'odom_linear_scale_correction': float('nan')}, 'must be a finite float'),
+                             ({'odom_angular_scale_correction': 3.0}, 'between 0.5 and 2.0'),
+                             ({'physics_rate': 50.0}, 'cannot change while the simulator runs'),
+                             ({'encoder_noise': 0.01, 'left_motor_error': 0.9}, 'between -0.5 and 0.5')):
+        with pytest.raises(ParameterError, match=problem):
+            sim.simulation.reconfigure(changes)
+        assert sim.simulation.config == before  # nothing changed, not even the valid half

@@ -30,6 +30,7 @@ from .gazebo import GazeboInterface
 from .lockstep import LOCKSTEP_POLL, LOCKSTEP_POLL_SHARE, Lockstep
 from .master_watch import MasterWatch
 from .publishers import Publishers
+from .reconfigure import Reconfigure
 from .robot_io import RobotIO
 
 WARN_PERIOD = 5.0    # s between repeats of the same warning
@@ -70,6 +71,7 @@ class SimulatorNode(object):
         self.markers_pub = self.publishers.advertise('world_markers', MarkerArray, latch=True)
         self.world_changed()
         self.gazebo = GazeboInterface(self)
+        self.reconfigure = Reconfigure(self)
         self._own_clock = rospy_internals.stop_following_clock()
         for name, handler in (('pause_physics', self._on_pause), ('unpause_physics', self._on_unpause),
                               ('reset_world', self._on_reset_world),
