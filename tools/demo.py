@@ -1,5 +1,11 @@
 """`make demo`: the tutorial's three scripts, end to end, on the pybullet TurtleBot3.
 
+With --calibrate (`make demo DEMO_ARGS="--calibrate"`) it runs the calibration
+walkthrough instead (tb3_harness/calibration.py): odom_out_and_back.py, the two
+calibration scripts measured against ground truth, the corrections set with
+dynparam, odom_out_and_back.py again; table in OUTPUT/calibration.txt, paths in
+OUTPUT/calibration_paths.png.
+
 Run inside `source setup.bash`. Starts one master on a free loopback port, then
 for each script does what the tutorial does: start the simulator fresh
 (`roslaunch tb3_sim_bringup tb3_empty_world.launch`), wait for odom ->
@@ -23,7 +29,7 @@ import subprocess
 import sys
 import time
 
-from tb3_harness import report
+from tb3_harness import calibration, report
 from tb3_harness.processes import RunError, say, start_master
 from tb3_harness.tutorial import LAUNCH, SCRIPTS, run_script
 from tb3_sim_nav.robot_model import TURTLEBOT3_MODELS
@@ -48,7 +54,11 @@ def parse_args(argv):
                         help='folder for demo_paths.png, summary.txt and logs/ (default: %(default)s)')
     parser.add_argument('--scripts', nargs='+', choices=[name for name, _ in SCRIPTS], metavar='SCRIPT',
                         help='run only these scripts (default: all three, in the tutorial\'s order)')
+    parser.add_argument('--calibrate', action='store_true',
+                        help='the calibration walkthrough (profile realistic) instead of the tutorial\'s scripts')
     args = parser.parse_args(argv)
+    if args.calibrate and (args.scripts or args.profile not in (None, 'realistic')):
+        parser.error('--calibrate runs its own scripts in profile realistic: no --scripts, no other --profile')
     if not args.real_time_factor >= 0.0:
         parser.error('--real-time-factor must be >= 0, not %r' % args.real_time_factor)
     return args
@@ -72,6 +82,20 @@ def check_environment(args):
                             % (LAUNCH[1], ', '.join(names)))
 
 
+def write_calibration(args, calibrated, total):
+    before, after, linear, angular, corrections = calibrated
+    text = '\n'.join(calibration.table(before, after, linear, angular, corrections, args.real_time_factor)
+                     + ['', 'total wall time %.1f s' % total])
+    print('\n' + text, flush=True)
+    summary_file = os.path.join(args.output, 'calibration.txt')
+    with open(summary_file, 'w') as summary:
+        summary.write(text + '\n')
+    picture = os.path.join(args.output, 'calibration_paths.png')
+    report.plot_paths([before, after], picture, 'odom_out_and_back.py before and after calibration '
+                      '(profile realistic, seed %d)' % calibration.SEED)
+    say('wrote %s and %s' % (picture, summary_file))
+
+
 def main(argv=None):
     args = parse_args(argv)
     log_dir = os.path.join(args.output, 'logs')
@@ -82,6 +106,7 @@ def main(argv=None):
     signal.signal(signal.SIGTERM, on_sigterm)
     signal.signal(signal.SIGINT, signal.default_int_handler)  # even if started with SIGINT ignored
 
+    calibrated = None
     scripts = [(name, expected) for name, expected in SCRIPTS if not args.scripts or name in args.scripts]
     master = None
     results, failures = [], []
@@ -94,7 +119,9 @@ def main(argv=None):
         rospy_up = True
         if rospy.rostime.is_wallclock():
             raise RunError('the demo node did not pick up /use_sim_time')
-        for script, expected in scripts:
+        if args.calibrate:
+            calibrated = calibration.calibrate(args.real_time_factor, log_dir)
+        for script, expected in scripts if not args.calibrate else ():
             result, error = run_script(script, expected, args, log_dir)
             results.append(result)
             if error:
@@ -116,6 +143,8 @@ def main(argv=None):
         signal.signal(signal.SIGINT, signal.default_int_handler)
 
     total = time.monotonic() - _T0
+    if calibrated is not None:
+        write_calibration(args, calibrated, total)
     model = args.model or os.environ.get('TURTLEBOT3_MODEL', 'burger')
     if results:
         header = ['tb3_sim_nav demo: the tutorial\'s scripts on the pybullet TurtleBot3 %s' % model,
@@ -138,6 +167,9 @@ def main(argv=None):
         print('\ndemo FAILED:\n  ' + '\n  '.join(failure.replace('\n', '\n    ') for failure in failures),
               file=sys.stderr, flush=True)
         return 1
+    if calibrated is not None:
+        say('demo done: calibration walkthrough complete')
+        return 0
     say('demo done: %d scripts, all exited 0' % len(results))
     return 0
 

@@ -130,6 +130,34 @@ def start_script_paused(sim, script, log_dir):
     return process
 
 
+def watch(sim, recorder, script, process, expected, factor, wall_start, sim_start, done=None):
+    """Until `process` exits, or done() is true: RunError if the simulator exits
+    or the script outlives its limits (TIMEOUT_FACTOR times its `expected` sim
+    seconds, in wall time at `factor`), a progress line every HEARTBEAT s."""
+    sim_limit = TIMEOUT_FACTOR * expected
+    wall_limit = STARTUP_SLACK + sim_limit / (factor or 1.0)
+    next_beat = wall_start + HEARTBEAT
+    while process.running() and not (done is not None and done()):
+        now = time.monotonic()
+        if not sim.running():
+            raise RunError('the simulator exited (code %s) while %s ran; %s ends with:\n%s'
+                            % (sim.popen.returncode, script, sim.log, tail(sim.log)))
+        # As fast as possible, the script's own start-up (python, rospy: wall
+        # seconds) is worth many sim seconds: there only the wall limit counts.
+        sim_over = factor > 0.0 and sim_now() - sim_start > sim_limit
+        if now - wall_start > wall_limit or sim_over:
+            raise RunError('%s still running after %.0f s wall / %.0f s sim (limits %.0f s / %.0f s, '
+                            '%.0fx its expected %.0f s sim); stopped it'
+                            % (script, now - wall_start, sim_now() - sim_start, wall_limit, sim_limit,
+                               TIMEOUT_FACTOR, expected))
+        if now >= next_beat:
+            pose = recorder.truth[-1]
+            say('%s: running, sim time %.1f s, robot at x %+.2f m, y %+.2f m'
+                % (script, sim_now() - sim_start, pose[1], pose[2]))
+            next_beat += HEARTBEAT
+        time.sleep(0.1)
+
+
 def run_script(script, expected, args, log_dir):
     """One round of the tutorial: fresh simulator, the script, simulator stopped.
 
@@ -162,28 +190,7 @@ def run_script(script, expected, args, log_dir):
             wall_start, sim_start = time.monotonic(), sim_now()
             start_index = (len(recorder.truth) - 1, len(recorder.odom) - 1)
             script_process = Process(script[:-3], ['rosrun', 'tb3_sim_nav', script], log_dir)
-        sim_limit = TIMEOUT_FACTOR * expected
-        wall_limit = STARTUP_SLACK + sim_limit / (args.real_time_factor or 1.0)
-        next_beat = wall_start + HEARTBEAT
-        while script_process.running():
-            now = time.monotonic()
-            if not sim.running():
-                raise RunError('the simulator exited (code %s) while %s ran; %s ends with:\n%s'
-                                % (sim.popen.returncode, script, sim.log, tail(sim.log)))
-            # As fast as possible, the script's own start-up (python, rospy: wall
-            # seconds) is worth many sim seconds: there only the wall limit counts.
-            sim_over = args.real_time_factor > 0.0 and sim_now() - sim_start > sim_limit
-            if now - wall_start > wall_limit or sim_over:
-                raise RunError('%s still running after %.0f s wall / %.0f s sim (limits %.0f s / %.0f s, '
-                                '%.0fx its expected %.0f s sim); stopped it'
-                                % (script, now - wall_start, sim_now() - sim_start, wall_limit, sim_limit,
-                                   TIMEOUT_FACTOR, expected))
-            if now >= next_beat:
-                pose = recorder.truth[-1]
-                say('%s: running, sim time %.1f s, robot at x %+.2f m, y %+.2f m'
-                    % (script, sim_now() - sim_start, pose[1], pose[2]))
-                next_beat += HEARTBEAT
-            time.sleep(0.1)
+        watch(sim, recorder, script, script_process, expected, args.real_time_factor, wall_start, sim_start)
         exit_code = script_process.popen.returncode
         wall_time, sim_time = time.monotonic() - wall_start, sim_now() - sim_start
         # One more ground truth sample from after the exit: the pose it left the robot in.
