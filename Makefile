@@ -21,16 +21,18 @@ $(VENV)/.ready: tools/requirements.txt
 # The workspace's copy of the package is a folder of links to the repo's
 # top-level entries, not one link to the repo: rosrun searches the package
 # folder with `find -L`, which would loop through $(WS) and crawl $(VENV).
-# gazebo_msgs, a package folder inside this one, gets a link of its own: catkin
-# does not look for packages inside a package.
+# gazebo_msgs, map_server and tb3_navigation, package folders inside this one,
+# get a link each: catkin does not look for packages inside a package.
 # catkin_make again whenever what it generates from could have changed.
-GAZEBO_MSGS := gazebo_msgs/CMakeLists.txt gazebo_msgs/package.xml $(wildcard gazebo_msgs/msg/* gazebo_msgs/srv/*)
-$(WS)/devel/.ready: CMakeLists.txt package.xml setup.py env-hooks/* $(wildcard cfg/*) $(wildcard scripts/*) $(wildcard test/*.test) $(GAZEBO_MSGS) | $(VENV)/.ready
+INNER_PACKAGES := gazebo_msgs map_server tb3_navigation
+INNER_FILES := $(foreach package,$(INNER_PACKAGES),$(package)/CMakeLists.txt $(package)/package.xml \
+  $(wildcard $(package)/setup.py $(package)/msg/* $(package)/srv/* $(package)/scripts/* $(package)/test/*.test))
+$(WS)/devel/.ready: CMakeLists.txt package.xml setup.py env-hooks/* $(wildcard cfg/*) $(wildcard scripts/*) $(wildcard test/*.test) $(INNER_FILES) | $(VENV)/.ready
 	[ ! -L $(WS)/src/tb3_sim_nav ] || rm $(WS)/src/tb3_sim_nav
 	mkdir -p $(WS)/src/tb3_sim_nav
 	find $(WS)/src/tb3_sim_nav -maxdepth 1 -type l -delete
 	for entry in *; do ln -s "$(CURDIR)/$$entry" "$(WS)/src/tb3_sim_nav/$$entry"; done
-	ln -sfn "$(CURDIR)/gazebo_msgs" $(WS)/src/gazebo_msgs
+	for package in $(INNER_PACKAGES); do ln -sfn "$(CURDIR)/$$package" "$(WS)/src/$$package"; done
 	cd $(WS) && catkin_make -DPYTHON_EXECUTABLE=$(PYTHON) -DCATKIN_ENABLE_TESTING=ON > build.log 2>&1 \
 	  || { tail -40 build.log; exit 1; }
 	touch $@
@@ -50,7 +52,7 @@ integration: setup
 # The packages as the workspace holds them: catkin_lint wants a package's
 # folder named as the package, and a clone's may not be.
 lint: setup
-	$(IN_ROS) catkin_lint --strict -W2 "$$(rospack find tb3_sim_nav)" "$$(rospack find gazebo_msgs)"
+	$(IN_ROS) catkin_lint --strict -W2 $(foreach package,tb3_sim_nav $(INNER_PACKAGES),"$$(rospack find $(package))")
 
 bench: setup
 	$(IN_ROS) python3 tools/bench.py $(BENCH_ARGS)

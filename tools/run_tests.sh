@@ -32,7 +32,8 @@ if [ "${1:-}" != --integration-only ]; then
   echo "== unit tests (pytest, no master)"
   run unit python3 -m pytest -q -p no:cacheprovider test/unit
   echo "== catkin_lint"
-  lint=$(catkin_lint --strict -W2 "$(rospack find tb3_sim_nav)" "$(rospack find gazebo_msgs)" 2>&1)
+  lint=$(catkin_lint --strict -W2 $(for package in tb3_sim_nav gazebo_msgs map_server tb3_navigation; do
+    echo "$(rospack find $package)"; done) 2>&1)
   echo "$lint" | tee "$logs/catkin_lint"
   echo "$lint" | grep -qE ': (error|warning|notice):' && failures+=(catkin_lint)
 fi

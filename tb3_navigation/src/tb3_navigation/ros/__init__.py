@@ -1,0 +1,1 @@
+"""The ROS edges of the navigation cores: one node a module, rospy only here."""

@@ -1,0 +1,117 @@
+"""How every node of ours ends: at once, whatever moment the request lands.
+
+A node is asked to end by a signal (Ctrl+C in its terminal or roslaunch's
+SIGINT, SIGTERM, SIGHUP), by `rosnode kill` or the master ("new node
+registered with same name"), both through rospy's XML-RPC thread, or by the
+death of the roslaunch that started it (SIGKILL), which tells it nothing.
+
+rospy's own signal handler runs rospy's whole shutdown (hooks, every
+connection closed) inside the handler: in the main thread, between two
+bytecodes of whatever that thread was doing. When that was a write holding a
+lock which closing a connection takes too, the handler waits for the code it
+interrupted: forever (issue 18: the simulator's publish path). So here a
+signal only sets a flag. The node's loop sees it, stops publishing, and
+only then shuts rospy down, from its own thread and outside any handler. A
+shutdown that rospy starts in another thread first asks the loop to stop and
+waits (briefly) until it has. A thread watches the parent: a node started by
+roslaunch or rostest ends when they are gone instead of living on as an orphan.
+"""
+import os
+import signal
+import threading
+import time
+
+import rospy
+
+PARENT_POLL = 0.5  # wall s between looks at the parent process
+LOOP_STOP_WAIT = 1.0  # wall s a shutdown from another thread waits for the node's loop to stop
+SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+LAUNCHERS = ('roslaunch', 'rostest')  # parents whose death ends the node
+
+
+def _command_line(pid):
+    try:
+        with open('/proc/%d/cmdline' % pid, 'rb') as stream:
+            return [part.decode('utf-8', 'replace') for part in stream.read().split(b'\0') if part]
+    except OSError:
+        return []
+
+
+def started_by_launcher(pid):
+    """True if process `pid` is a roslaunch or rostest (a python running either)."""
+    return any(os.path.basename(part) in LAUNCHERS for part in _command_line(pid)[:2])
+
+
+class Life(object):
+    """A node's request to end (a flag, its reason) and the end itself.
+
+    `stopping` is true once an end was asked for, in any of the ways above.
+    A node with a loop of its own runs `while not life.stopping:` and then
+    calls `finish()`; a node driven by callbacks calls `spin()`.
+    """
+
+    def __init__(self):
+        self._stop = threading.Event()
+        self._loop_done = threading.Event()
+        self.reason = None
+
+    def request_stop(self, reason):
+        """Safe in a signal handler: sets the flag, nothing else."""
+        if not self._stop.is_set():
+            self.reason = reason
+            self._stop.set()
+
+    @property
+    def stopping(self):
+        return self._stop.is_set() or rospy.core.is_shutdown_requested()
+
+    def sleep(self, seconds):
+        """Waits `seconds` of wall time, less if an end is asked for; False then."""
+        return not self._stop.wait(seconds) and not rospy.core.is_shutdown_requested()
+
+    def spin(self):
+        """Until an end is asked for (callbacks run in rospy's threads meanwhile); then finish()."""
+        while self.sleep(0.1):
+            pass
+        self.finish()
+
+    def finish(self):
+        """The node's loop has stopped: shut rospy down from here (it closes every connection)."""
+        self._loop_done.set()
+        rospy.signal_shutdown(self.reason or 'asked to end')
+
+    # --- the ways an end comes --------------------------------------------------
+    def _on_signal(self, number, _frame):
+        self.request_stop('%s received' % signal.Signals(number).name)
+
+    def _on_rospy_shutdown(self):
+        """rospy's shutdown started elsewhere (rosnode kill, the master, finish()):
+        let the loop stop publishing before rospy closes the connections."""
+        self.request_stop(self.reason or 'rospy shut down')
+        if threading.current_thread() is not threading.main_thread():
+            self._loop_done.wait(LOOP_STOP_WAIT)
+
+    def _watch_parent(self, parent):
+        while not self._stop.is_set():
+            if os.getppid() != parent:
+                self.request_stop('the roslaunch that started this node (pid %d) is gone' % parent)
+                rospy.logwarn('%s: the roslaunch that started it (pid %d) is gone: shutting down',
+                              rospy.get_name(), parent)
+                return
+            time.sleep(PARENT_POLL)
+
+
+def init_node(name, **keywords):
+    """rospy.init_node(name, ...) with the ends above wired: the node's Life.
+
+    Call from the main thread, as rospy.init_node; handlers installed before it
+    registers, so that no signal finds rospy's own."""
+    life = Life()
+    for number in SIGNALS:
+        signal.signal(number, life._on_signal)
+    rospy.init_node(name, disable_signals=True, **keywords)
+    rospy.on_shutdown(life._on_rospy_shutdown)
+    parent = os.getppid()
+    if started_by_launcher(parent):
+        threading.Thread(target=life._watch_parent, args=(parent,), name='parent_watch', daemon=True).start()
+    return life

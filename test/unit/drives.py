@@ -1,0 +1,107 @@
+"""Recorded drives of a simulated Burger, for the tests of the navigation cores (no ROS).
+
+record_drive() drives the pybullet Burger of tb3_sim_nav's core through
+waypoints in a world file, steering on the true pose (the test's driver,
+not the code under test), and records at the lidar's 5 Hz what a node on
+the robot would get: the scan, the odometry (the profile's: the true pose
+under 'gazebo', drifting wheel odometry under 'realistic') and, for the
+test's judgement only, the true pose. The navigation cores see only scans
+and odometry.
+"""
+import math
+from collections import namedtuple
+
+import numpy as np
+
+from tb3_sim_nav.params import resolve
+from tb3_sim_nav.robot_model import load_model
+from tb3_sim_nav.simulation import build
+from tb3_sim_nav.world_file import load_world
+
+from conftest import REPO
+
+#: base_scan in base_footprint on the Burger (x, y, yaw): (-0.032, 0, 0.182) in 3-D.
+BURGER_SCAN_POSE = (-0.032, 0.0, 0.0)
+SCAN_PERIOD_NS = 200000000  # 5 Hz
+CONTROL_PERIOD_NS = 30000000  # a command every 30 ms of sim time
+
+#: One drive: times (n,) s; truth and odom (n, 3) (x, y, yaw); ranges (n, beams);
+#: the scan's angle_min, angle_increment, range_min, range_max; the sensor's pose in the base frame.
+Drive = namedtuple('Drive', 'times truth odom ranges angle_min angle_increment range_min range_max scan_pose')
+
+
+def _yaw(orientation):
+    x, y, z, w = orientation
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def _pose(pose):
+    (x, y, _), orientation = pose
+    return x, y, _yaw(orientation)
+
+
+def _steer(pose, target, speed, turn_speed):
+    """(v, w) towards `target` from `pose`: turn in place when facing away."""
+    dx, dy = target[0] - pose[0], target[1] - pose[1]
+    error = math.atan2(dy, dx) - pose[2]
+    error = (error + math.pi) % (2 * math.pi) - math.pi
+    w = max(-turn_speed, min(turn_speed, 2.5 * error))
+    v = 0.0 if abs(error) > 0.4 else speed * max(0.0, math.cos(error)) * min(1.0, math.hypot(dx, dy) / 0.15 + 0.3)
+    return v, w
+
+
+def record_drive(world, start, waypoints, profile='realistic', seed=7, speed=0.18, turn_speed=1.0,
+                 reach=0.05, settle=1.0, overrides=None):
+    """The Drive of a Burger spawned at `start` (x, y, yaw) in `world` (a name in
+    worlds/ or a path) going through `waypoints` [(x, y)], each reached within
+    `reach` m, then standing `settle` s."""
+    values = dict(profile=profile, seed=seed, **(overrides or {}))
+    config = resolve(lambda name, default: values.get(name, default))
+    obstacles = load_world(world, str(REPO / 'worlds')).obstacles
+    model = load_model(str(REPO / 'urdf' / 'turtlebot3_burger.urdf'))
+    simulation = build(config, obstacles, [('', model, (start[0], start[1], 0.0, start[2]))])
+    try:
+        robot = simulation.robots['']
+        lidar = robot.lidar
+        times, truth, odom, ranges = [], [], [], []
+        targets = list(waypoints)
+        standing_until = None
+        while True:
+            now = simulation.now_ns
+            if now % CONTROL_PERIOD_NS == 0:
+                pose = _pose(robot.truth()[0])
+                while targets and math.hypot(targets[0][0] - pose[0], targets[0][1] - pose[1]) < reach:
+                    targets.pop(0)
+                if targets:
+                    robot.command(*_steer(pose, targets[0], speed, turn_speed), now_ns=now)
+                else:
+                    robot.command(0.0, 0.0, now)
+                    if standing_until is None:
+                        standing_until = now + int(settle * 1e9)
+            if now % SCAN_PERIOD_NS == 0:
+                true_pose, _ = robot.truth()
+                odom_pose, _ = robot.odometry()
+                times.append(now * 1e-9)
+                truth.append(_pose(true_pose))
+                odom.append(_pose(odom_pose))
+                ranges.append(robot.scan())
+            if standing_until is not None and now >= standing_until:
+                break
+            simulation.step()
+        return Drive(np.array(times), np.array(truth), np.array(odom), np.array(ranges), 0.0,
+                     lidar.angle_increment, lidar.range_min, lidar.range_max, BURGER_SCAN_POSE)
+    finally:
+        simulation.close()
+
+
+#: A loop of about 13 m around turtlebot3_world's pillars from tb3_world.launch's
+#: spawn pose (-2.0, -0.5): up the west side, across the north, down the east,
+#: back along the south, and home.
+WORLD_LOOP_START = (-2.0, -0.5, 0.0)
+WORLD_LOOP = [(-1.65, -0.5), (-1.65, 1.65), (0.55, 1.65), (1.65, 1.65), (1.65, -0.55), (1.65, -1.65),
+              (-0.55, -1.65), (-1.65, -1.65), (-1.65, -0.5), (-2.0, -0.5)]
+
+
+def path_length(points):
+    points = np.asarray(points, dtype=float)
+    return float(np.sum(np.hypot(*np.diff(points[:, :2], axis=0).T)))
