@@ -29,7 +29,7 @@ import subprocess
 import sys
 import time
 
-from tb3_harness import calibration, report
+from tb3_harness import calibration, leftovers, report
 from tb3_harness.processes import RunError, say, start_master
 from tb3_harness.tutorial import LAUNCH, SCRIPTS, run_script
 from tb3_sim_nav.robot_model import TURTLEBOT3_MODELS
@@ -175,4 +175,4 @@ def main(argv=None):
 
 
 if __name__ == '__main__':
-    sys.exit(main())
+    sys.exit(leftovers.run('make demo', main))

@@ -13,10 +13,14 @@ trap 'rm -rf "$logs"' EXIT
 failures=()
 
 # run NAME COMMAND...: run it, its output to the terminal and to $logs/NAME.
+# What it starts carries TB3_RUN=NAME.PID; any such process still running
+# after it fails the part (tb3_harness.leftovers names and ends it).
 run() {
   local name=$1
   shift
-  "$@" 2>&1 | tee "$logs/$name" || failures+=("$name")
+  TB3_RUN="$name.$$" "$@" 2>&1 | tee "$logs/$name" || failures+=("$name")
+  TB3_RUN="$name.$$" python3 -m tb3_harness.leftovers check "$name" 2>&1 | tee -a "$logs/$name" \
+    || failures+=("$name (left processes running)")
 }
 
 # The lines of a failed part's output that say what failed: rostest's failure
@@ -24,7 +28,7 @@ run() {
 # line of each traceback, the soak's missed rows.
 why() {
   { grep -E -A1 '\]\[(FAILURE|ERROR)\]' "$1"
-    grep -E '^(FAILED|ERROR) |(Error|Exception)(: |$)|  MISSED$|FAILED: |^Summary: ' "$1"
+    grep -E '^(FAILED|ERROR) |(Error|Exception)(: |$)|  MISSED$|FAILED: |^Summary: |LEFT RUNNING' "$1"
   } | grep -v '^--$' | awk '!seen[$0]++' | head -40
 }
 

@@ -23,6 +23,7 @@ import sys
 import time
 
 import bench
+from tb3_harness import leftovers
 from tb3_harness.measure import machine, memory_mib, sim_pid
 from tb3_harness.processes import Process, RunError, say, start_master, wait_until
 
@@ -194,4 +195,4 @@ def main(argv=None):
 
 
 if __name__ == '__main__':
-    sys.exit(main())
+    sys.exit(leftovers.run('make soak', main))

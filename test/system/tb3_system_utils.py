@@ -26,6 +26,15 @@ def master_pid(port):
     return harness.master_pid(master_uri(port))
 
 
+def alive(pid):
+    """True while process `pid` runs (a zombie, ended but not yet reaped, does not)."""
+    try:
+        with open('/proc/%d/stat' % pid) as stream:
+            return stream.read().rsplit(')', 1)[1].split()[0] != 'Z'
+    except OSError:
+        return False
+
+
 def wait_until(predicate, timeout, poll=0.2):
     """Poll until `predicate()` is true or `timeout` wall s pass; its last value."""
     deadline = time.monotonic() + timeout

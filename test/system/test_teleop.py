@@ -14,6 +14,7 @@ it fails.
 """
 import math
 import os
+import re
 import pty
 import select
 import signal
@@ -24,7 +25,7 @@ import time
 
 import pytest
 
-from tb3_system_utils import harness, run, wait_until
+from tb3_system_utils import alive, harness, run, wait_until
 
 TELEOP = ['rosrun', 'tb3_sim_nav', 'tb3_teleop_key']
 MULTI = ['roslaunch', 'tb3_sim_bringup', 'multi_tb3.launch']
@@ -265,7 +266,7 @@ def test_keys_set_cmd_vel_smoothly_and_drive_the_robot_forward_and_left(truth, p
     assert abs(end['speed'] - 0.05) < 0.005 and abs(end['turn'] - 0.3) < 0.03, end
 
 
-@pytest.mark.parametrize('how', ['ctrl_c', 'hang_up', 'sigterm'])
+@pytest.mark.parametrize('how', ['ctrl_c', 'hang_up', 'sigterm', 'rosnode_kill'])
 def test_exit_publishes_a_stop_the_robot_rests_the_terminal_is_restored(how, truth, processes, tmp_path):
     cmd_vel = Echo(processes, '/cmd_vel')
     teleop = start_teleop(processes, tmp_path, cmd_vel, argv=TELEOP + ['_model:=burger'])
@@ -279,8 +280,10 @@ def test_exit_publishes_a_stop_the_robot_rests_the_terminal_is_restored(how, tru
         teleop.type('\x03')
     elif how == 'hang_up':
         teleop.hang_up()
-    else:
+    elif how == 'sigterm':
         os.kill(teleop.popen.pid, signal.SIGTERM)
+    else:
+        assert run(['rosnode', 'kill', '/turtlebot3_teleop'], 30.0).returncode == 0
     ended = wait_until(lambda: not teleop.running(), EXIT_WITHIN)
     exited = time.monotonic() - asked
     assert ended, 'the teleop still runs %.0f s after %s' % (EXIT_WITHIN, how)
@@ -379,6 +382,26 @@ def test_roslaunch_gives_the_node_the_terminal(master, processes, tmp_path, monk
     assert stopped, 'the last cmd_vel is %s' % (last(twists(cmd_vel)),)
     assert 'Stopped' in launch.output(), launch.output()[-2000:]
     assert launch.settings() == launch.settings_before
+
+
+def test_a_killed_roslaunch_leaves_no_teleop_behind(master, processes, tmp_path, monkeypatch):
+    """roslaunch killed outright (SIGKILL: it cannot stop its nodes): the
+    teleop notices that its parent is gone, publishes a stop and ends."""
+    monkeypatch.setenv('TURTLEBOT3_MODEL', 'burger')
+    cmd_vel = Echo(processes, '/cmd_vel')
+    launch = start_teleop(processes, tmp_path, cmd_vel, name='roslaunch_teleop',
+                          argv=['roslaunch', 'tb3_sim_bringup', 'tb3_teleop_key.launch'])
+    type_and_see(launch, 'w' * 3, 0.03, 0.0)
+    wait_for_twist(cmd_vel, 0.03, 0.0)
+    node = run(['rosnode', 'info', '/turtlebot3_teleop_keyboard'], 30.0).stdout
+    pid = int(re.search(r'Pid: (\d+)', node).group(1))
+    os.kill(launch.popen.pid, signal.SIGKILL)
+    killed = time.monotonic()
+    gone = wait_until(lambda: not alive(pid), 10.0)
+    took = time.monotonic() - killed
+    print('MEASURED teleop ended %.2f s after its roslaunch was killed' % took)
+    assert gone and took < 5.0, 'the teleop (pid %d) outlived its roslaunch by %.1f s' % (pid, took)
+    assert wait_until(lambda: last(twists(cmd_vel)) == ZERO, 5.0), last(twists(cmd_vel))
 
 
 def test_in_a_namespace_it_drives_one_robot_of_three(master, processes, tmp_path, monkeypatch):

@@ -15,6 +15,7 @@ import rospkg
 import rospy
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty, EmptyResponse
+from tb3_navigation.ros import lifecycle
 from tf2_msgs.msg import TFMessage
 from visualization_msgs.msg import MarkerArray
 
@@ -42,11 +43,13 @@ RESTORED_PARAMETERS = ('/use_sim_time', '/robot_description')  # set again on a 
 class SimulatorNode(object):
     """Steps the simulation in sim time and publishes what Gazebo's TurtleBot3s do."""
 
-    def __init__(self, config, simulation, descriptions):
+    def __init__(self, config, simulation, descriptions, life):
+        """`life`: the node's lifecycle.Life; the step loop runs until it says stop."""
         self.config = config
         self.sim = simulation
         self.descriptions = descriptions
-        self.pacer = Pacer(config.real_time_factor, paused=config.paused)
+        self.life = life
+        self.pacer = Pacer(config.real_time_factor, paused=config.paused, sleep=life.sleep)
         self._requests = queue.Queue()  # work of other threads, for the step loop
         self._throttle = Throttle(WARN_PERIOD)
         self._hold_until = 0.0
@@ -124,8 +127,12 @@ class SimulatorNode(object):
         """work()'s result, run by the step loop between steps; its exception raised here."""
         done, result = threading.Event(), {}
         self._requests.put((work, done, result))
-        if not done.wait(timeout):
-            raise ModelStateError('the simulator did not get to the request within %g s (wall)' % timeout)
+        deadline = time.monotonic() + timeout
+        while not done.wait(IDLE_POLL * 10):
+            if self.life.stopping:
+                raise ModelStateError('the simulator is shutting down')
+            if time.monotonic() > deadline:
+                raise ModelStateError('the simulator did not get to the request within %g s (wall)' % timeout)
         if 'error' in result:
             raise result['error']
         return result.get('value')
@@ -195,7 +202,9 @@ class SimulatorNode(object):
 
     # --- the step loop ------------------------------------------------------
     def run(self):
-        while not rospy.is_shutdown():
+        """Steps until the node is asked to end (lifecycle: a signal only sets a flag), so that
+        nothing closes a connection while the step loop writes to it."""
+        while not self.life.stopping:
             self._serve_requests()
             if self.pacer.paused or time.monotonic() < self._hold_until:
                 self.pacer.restart()
@@ -302,7 +311,7 @@ def _start_up():
 
 
 def main():
-    rospy.init_node('tb3_sim')
+    life = lifecycle.init_node('tb3_sim')
     config, simulation = _start_up()
     if config.real_time_factor == 0.0:
         # As fast as possible, but only on CPU that no other node wants, so
@@ -312,9 +321,10 @@ def main():
     restored = dict((name, rospy.get_param(name)) for name in RESTORED_PARAMETERS if rospy.has_param(name))
     descriptions = Descriptions(restored, config.robot_state_publisher)
     try:
-        node = SimulatorNode(config, simulation, descriptions)
+        node = SimulatorNode(config, simulation, descriptions, life)
         MasterWatch(restored).start()
         node.run()
     finally:
+        life.finish()  # the step loop has stopped: now rospy may close every connection
         descriptions.stop_all()
         simulation.close()

@@ -81,6 +81,11 @@ class Life(object):
         rospy.signal_shutdown(self.reason or 'asked to end')
 
     # --- the ways an end comes --------------------------------------------------
+    def handle_signals(self):
+        """SIGINT, SIGTERM and SIGHUP only set the flag from now on (call from the main thread)."""
+        for number in SIGNALS:
+            signal.signal(number, self._on_signal)
+
     def _on_signal(self, number, _frame):
         self.request_stop('%s received' % signal.Signals(number).name)
 
@@ -107,8 +112,7 @@ def init_node(name, **keywords):
     Call from the main thread, as rospy.init_node; handlers installed before it
     registers, so that no signal finds rospy's own."""
     life = Life()
-    for number in SIGNALS:
-        signal.signal(number, life._on_signal)
+    life.handle_signals()
     rospy.init_node(name, disable_signals=True, **keywords)
     rospy.on_shutdown(life._on_rospy_shutdown)
     parent = os.getppid()
