@@ -1,4 +1,4 @@
-"""Lockstep: each step waits until the local nodes that publish cmd_vel have reacted.
+"""Lockstep: each step waits until the local nodes that drive the robots or place them on a map have reacted.
 
 See Lockstep's docstring; quiescence.py reads the processes' state off /proc.
 """
@@ -6,6 +6,7 @@ import math
 import time
 import xmlrpc.client
 
+import rosgraph
 import rospy
 
 from ..quiescence import InputWaits, ProcessGone, ProcessWatch
@@ -23,18 +24,24 @@ class _TimeoutTransport(xmlrpc.client.Transport):
         return connection
 
 
-def local_pid(connection):
-    """PID of the node at the other end of a subscriber connection, asked over
-    its XML-RPC API (as rosnode does); None if it runs on another machine.
-    Raises LookupError when a node on this machine does not tell."""
+def _remote(connection):
+    """True if the node at the other end of a connection runs on another machine (or it closed)."""
     try:
         sock = connection.socket
-        if sock.getpeername()[0] != sock.getsockname()[0]:
-            return None
+        return sock.getpeername()[0] != sock.getsockname()[0]
     except (AttributeError, OSError):  # closed meanwhile: nothing to wait for
+        return True
+
+
+def local_pid(connection, uri=None):
+    """PID of the node at the other end of a connection, asked over its XML-RPC
+    API (as rosnode does) at `uri` (a subscriber connection's endpoint_id if
+    None); None if it runs on another machine. Raises LookupError when a node
+    on this machine does not tell."""
+    if _remote(connection):
         return None
     try:
-        proxy = xmlrpc.client.ServerProxy(connection.endpoint_id, transport=_TimeoutTransport())
+        proxy = xmlrpc.client.ServerProxy(uri or connection.endpoint_id, transport=_TimeoutTransport())
         code, message, pid = proxy.getPid(rospy.get_name())
     except Exception as error:  # refused, timed out, not a ROS node
         raise LookupError(str(error) or type(error).__name__)
@@ -44,7 +51,9 @@ def local_pid(connection):
 
 
 class Lockstep(object):
-    """Holds each step until the local nodes that publish cmd_vel have reacted to it.
+    """Holds each step until the local nodes that publish cmd_vel, and those that
+    read a robot's scan and publish tf (a SLAM or a localizer: gmapping, amcl,
+    ours), have reacted to it.
 
     Otherwise a node's reaction to a tick costs it wall time in which the
     simulator runs on: its commands land late in sim time, and a rospy.Rate
@@ -57,6 +66,7 @@ class Lockstep(object):
 
     def __init__(self, timeout, poll, warnings, warn_period):
         self._subscribers = []  # the cmd_vel subscribers of every robot
+        self._readers = []  # the scan publishers of every robot
         self._timeout = timeout
         self._poll = poll
         self._warnings = warnings
@@ -77,32 +87,70 @@ class Lockstep(object):
         self._subscribers.remove(subscriber)
         self._connections = None
 
+    def follow_readers(self, publisher):
+        """Wait also for the local subscribers of `publisher` (a robot's scan) that publish tf."""
+        self._readers.append(publisher)
+        self._connections = None
+
+    def forget_readers(self, publisher):
+        self._readers.remove(publisher)
+        self._connections = None
+
+    @staticmethod
+    def _tf_publishers():
+        """Caller ids of the nodes that publish /tf, and the master, to look up a node's URI."""
+        master = rosgraph.Master(rospy.get_name())
+        publishers = dict(master.getSystemState()[0])
+        return set(publishers.get(rospy.resolve_name('tf'), ())), master
+
     def _follow_publishers(self):
-        """Watch the processes of cmd_vel's publishers, anew whenever they change."""
+        """Watch the processes of cmd_vel's publishers and of the scan's local readers
+        that publish tf, anew whenever they change (and each second while a local
+        reader does not publish tf: a node may subscribe before it advertises)."""
         # rospy replaces a list whenever a connection comes or goes, and lists
         # a connection before a thread of its own has connected it: look
         # again each step until every listed one has its handshake done.
-        lists = [rospy_internals.subscriber_connections(subscriber) for subscriber in self._subscribers]
+        lists = ([rospy_internals.subscriber_connections(subscriber) for subscriber in self._subscribers]
+                 + [rospy_internals.publisher_connections(publisher) for publisher in self._readers])
         if (self._connections is not None and len(lists) == len(self._connections)
                 and all(now is then for now, then in zip(lists, self._connections))
                 and not self._connecting and time.monotonic() < self._ask_again_at):
             return
         self._connections = lists
-        connections = [connection for listed in lists for connection in listed]
-        connected = [connection for connection in connections if connection.header is not None]
-        self._connecting = len(connected) < len(connections)
-        names = set(connection.callerid_pub for connection in connected)
+        drivers = [connection for listed in lists[:len(self._subscribers)] for connection in listed]
+        connected = [(connection.callerid_pub, connection, None) for connection in drivers
+                     if connection.header is not None]
+        self._connecting = len(connected) < len(drivers)
+        readers = [connection for listed in lists[len(self._subscribers):] for connection in listed
+                   if not _remote(connection)]
+        undecided = False
+        if readers:
+            try:
+                tf_publishers, master = self._tf_publishers()
+            except Exception as error:  # the master is away: look again in a second
+                tf_publishers, master, undecided = (), None, True
+                if self._warnings.allow('lockstep master'):
+                    rospy.loginfo('lockstep: cannot ask the master which scan readers publish tf (%s)', error)
+            for connection in readers:
+                if connection.endpoint_id in tf_publishers:
+                    connected.append((connection.endpoint_id, connection, master))
+                else:
+                    undecided = True
+        names = set(name for name, _, _ in connected)
         for name in set(self._watches) - names:
             self._watches.pop(name).close()
             self._behind.discard(name)
         self.receive_threads.clear()  # ended connections' threads; live ones come back
         unknown = []
-        for connection in connected:
-            name = connection.callerid_pub
+        for name, connection, master in connected:
             if name in self._watches:
                 continue
             try:
-                pid = local_pid(connection)
+                try:
+                    uri = master.lookupNode(name) if master else None
+                except Exception as error:  # gone, or the master is away
+                    raise LookupError('the master does not know it: %s' % error)
+                pid = local_pid(connection, uri)
                 if pid is not None:
                     self._watches[name] = ProcessWatch(pid)
             except ProcessGone:
@@ -110,7 +158,7 @@ class Lockstep(object):
             except LookupError as error:
                 unknown.append('%s (%s)' % (name, error))
         # Not waited for until it tells: ask again a second later.
-        self._ask_again_at = time.monotonic() + PID_RETRY if unknown else math.inf
+        self._ask_again_at = time.monotonic() + PID_RETRY if unknown or undecided else math.inf
         if unknown and self._warnings.allow('lockstep pid'):
             rospy.loginfo('lockstep: no PID from %s: not waiting for it; asking again every %g s (wall)',
                           ', '.join(unknown), PID_RETRY)

@@ -30,6 +30,7 @@ from .descriptions import Descriptions
 from .gazebo import GazeboInterface
 from .lockstep import LOCKSTEP_POLL, LOCKSTEP_POLL_SHARE, Lockstep
 from .master_watch import MasterWatch
+from .odom_parents import WorldLinks
 from .publishers import Publishers
 from .reconfigure import Reconfigure
 from .robot_io import RobotIO
@@ -62,6 +63,7 @@ class SimulatorNode(object):
         self.clock_pub = self.publishers.advertise('clock', Clock, latch=True, on_subscribe=self._hold_clock)
         self.tf_pub = self.publishers.advertise('tf', TFMessage)
         self._tf = TFMessage()
+        self.world_links = WorldLinks(config.world_frame, ()) if config.world_frame else None
         self.lockstep = None
         if config.lockstep:
             # Paced, a step has wall time to spare: look less often, for less CPU.
@@ -84,15 +86,13 @@ class SimulatorNode(object):
     def _add_io(self, robot):
         io = self.robots[robot.name] = RobotIO(robot, self.config, self.publishers, self._throttle,
                                                 self._command_received if self.lockstep else None)
-        self._update_tf()
+        if self.world_links:
+            self.world_links.parents.add(io.odom_frame)
         if self.lockstep:
             self.lockstep.follow(io.cmd_vel)
+            if io.scan_pub:
+                self.lockstep.follow_readers(io.scan_pub)
         self.descriptions.start(robot)
-
-    def _update_tf(self):
-        """One tf message for every robot's odom -> base and world -> odom."""
-        self._tf.transforms = [io.transform for io in self.robots.values()] + [
-            io.world_transform for io in self.robots.values() if io.world_transform is not None]
 
     def spawn_robot(self, name, model, pose, model_name):
         """A robot spawned while running (in the step loop): it gets what a launched one has."""
@@ -113,9 +113,10 @@ class SimulatorNode(object):
         io = self.robots.pop(robot.name)
         if self.lockstep:
             self.lockstep.forget(io.cmd_vel)
+            if io.scan_pub:
+                self.lockstep.forget_readers(io.scan_pub)
         io.close()
         self.descriptions.stop(robot.name)
-        self._update_tf()
 
     def world_changed(self, stamp=None):
         """The world's obstacles and objects drawn anew on world_markers (latched)."""
@@ -247,6 +248,9 @@ class SimulatorNode(object):
                 rospy_internals.set_time(stamp)
             for io in robots:
                 io.publish_odometry(stamp)
+            # One tf message for every robot's odom -> base and the world's links.
+            self._tf.transforms = [io.transform for io in robots] + (
+                self.world_links.links(robots, stamp) if self.world_links else [])
             self.tf_pub.publish(self._tf)
             if any(not body.static for body in self.sim.world.objects.values()):
                 self.world_changed(stamp)  # what moves is drawn where it is now

@@ -29,7 +29,8 @@ class RobotIO(object):
         self._on_command = on_command
         self._command = (0.0, 0.0, 0)  # v, w, count of commands received
         self._applied = 0
-        odom_frame, base_frame = prefix + config.odom_frame, prefix + config.base_frame
+        self.odom_frame = odom_frame = prefix + config.odom_frame
+        base_frame = prefix + config.base_frame
         self.odom = messages.odometry(odom_frame, base_frame)
         self.truth = messages.odometry(odom_frame, base_frame, covariance=False)
         self.transform = messages.transform(odom_frame, base_frame)

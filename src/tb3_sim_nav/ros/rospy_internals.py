@@ -49,8 +49,27 @@ def wrap_connections(publisher, wrap):
 
 
 def publisher_connections(publisher):
-    """The connections of a Publisher (as wrapped by wrap_connections)."""
-    return publisher.impl.connections if publisher.impl is not None else ()
+    """The current list of a Publisher's subscriber connections (rospy replaces the
+    list whenever one comes or goes), each with `endpoint_id` (the subscriber's
+    caller id) and `socket`. Relies on _PublisherImpl.connections."""
+    impl = publisher.impl
+    return impl.connections if impl is not None else ()
+
+
+def ignore_own_publications(subscriber):
+    """Never connect `subscriber` to this node's own publisher of its topic
+    (rospy would, and send each of our messages through a socket back to us).
+    Relies on rospy asking Subscriber.impl.has_connection(publisher URI)
+    before it connects (masterslave._connect_topic)."""
+    impl, own = subscriber.impl, rospy.core.get_node_uri()
+    has_connection = impl.has_connection
+    impl.has_connection = lambda uri: uri == own or has_connection(uri)
+
+
+def caller_id(message):
+    """The node that published a received message. Relies on rospy's
+    _connection_header, which it sets on every message it delivers."""
+    return message._connection_header.get('callerid', '')
 
 
 def register_again(master, parameters):
