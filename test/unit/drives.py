@@ -18,6 +18,8 @@ from tb3_sim_nav.robot_model import load_model
 from tb3_sim_nav.simulation import build
 from tb3_sim_nav.world_file import load_world
 
+from tb3_harness.waypoints import WORLD_LOOP, WORLD_LOOP_START, Route, path_length  # noqa: F401 (for the tests)
+
 from conftest import REPO
 
 #: base_scan in base_footprint on the Burger (x, y, yaw): (-0.032, 0, 0.182) in 3-D.
@@ -40,16 +42,6 @@ def _pose(pose):
     return x, y, _yaw(orientation)
 
 
-def _steer(pose, target, speed, turn_speed):
-    """(v, w) towards `target` from `pose`: turn in place when facing away."""
-    dx, dy = target[0] - pose[0], target[1] - pose[1]
-    error = math.atan2(dy, dx) - pose[2]
-    error = (error + math.pi) % (2 * math.pi) - math.pi
-    w = max(-turn_speed, min(turn_speed, 2.5 * error))
-    v = 0.0 if abs(error) > 0.4 else speed * max(0.0, math.cos(error)) * min(1.0, math.hypot(dx, dy) / 0.15 + 0.3)
-    return v, w
-
-
 def record_drive(world, start, waypoints, profile='realistic', seed=7, speed=0.18, turn_speed=1.0,
                  reach=0.05, settle=1.0, overrides=None):
     """The Drive of a Burger spawned at `start` (x, y, yaw) in `world` (a name in
@@ -64,20 +56,14 @@ def record_drive(world, start, waypoints, profile='realistic', seed=7, speed=0.1
         robot = simulation.robots['']
         lidar = robot.lidar
         times, truth, odom, ranges = [], [], [], []
-        targets = list(waypoints)
+        route = Route(waypoints, reach)
         standing_until = None
         while True:
             now = simulation.now_ns
             if now % CONTROL_PERIOD_NS == 0:
-                pose = _pose(robot.truth()[0])
-                while targets and math.hypot(targets[0][0] - pose[0], targets[0][1] - pose[1]) < reach:
-                    targets.pop(0)
-                if targets:
-                    robot.command(*_steer(pose, targets[0], speed, turn_speed), now_ns=now)
-                else:
-                    robot.command(0.0, 0.0, now)
-                    if standing_until is None:
-                        standing_until = now + int(settle * 1e9)
+                robot.command(*route.command(_pose(robot.truth()[0]), speed, turn_speed), now_ns=now)
+                if route.done and standing_until is None:
+                    standing_until = now + int(settle * 1e9)
             if now % SCAN_PERIOD_NS == 0:
                 true_pose, _ = robot.truth()
                 odom_pose, _ = robot.odometry()
@@ -92,16 +78,3 @@ def record_drive(world, start, waypoints, profile='realistic', seed=7, speed=0.1
                      lidar.angle_increment, lidar.range_min, lidar.range_max, BURGER_SCAN_POSE)
     finally:
         simulation.close()
-
-
-#: A loop of about 13 m around turtlebot3_world's pillars from tb3_world.launch's
-#: spawn pose (-2.0, -0.5): up the west side, across the north, down the east,
-#: back along the south, and home.
-WORLD_LOOP_START = (-2.0, -0.5, 0.0)
-WORLD_LOOP = [(-1.65, -0.5), (-1.65, 1.65), (0.55, 1.65), (1.65, 1.65), (1.65, -0.55), (1.65, -1.65),
-              (-0.55, -1.65), (-1.65, -1.65), (-1.65, -0.5), (-2.0, -0.5)]
-
-
-def path_length(points):
-    points = np.asarray(points, dtype=float)
-    return float(np.sum(np.hypot(*np.diff(points[:, :2], axis=0).T)))
