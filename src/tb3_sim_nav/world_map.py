@@ -37,7 +37,9 @@ def _local(obstacle, points):
 
 def signed_distance(obstacles, points):
     """Distance (n,) from each point (n, 2) to the nearest obstacle's outline in
-    the plane: negative inside an obstacle; +inf if there is none."""
+    the plane, negative inside an obstacle (the smallest of the obstacles' signed
+    distances: where obstacles overlap, a point inside one and near another's
+    outside is inside); +inf if there is none."""
     points = np.asarray(points, dtype=float).reshape(-1, 2)
     nearest = np.full(len(points), np.inf)
     for obstacle in obstacles:
@@ -49,7 +51,7 @@ def signed_distance(obstacles, points):
             distance = np.where((out_x <= 0) & (out_y <= 0), np.maximum(out_x, out_y), outside)
         else:
             distance = np.hypot(x, y) - obstacle.size[0]
-        nearest = np.where(np.abs(distance) < np.abs(nearest), distance, nearest)
+        nearest = np.minimum(nearest, distance)
     return nearest
 
 

@@ -212,3 +212,70 @@ def test_a_bad_map_as_world_names_the_file_and_the_key(tmp_path):
     (tmp_path / 'n.yaml').write_text('image: m.png\n')
     with pytest.raises(WorldError, match=r"key 'resolution': missing"):
         load_world(str(tmp_path / 'n.yaml'), WORLDS)
+
+
+# --- world_to_map and the rasterisation behind it ---------------------------------------------
+@pytest.mark.parametrize('world', ['turtlebot3_world', 'turtlebot3_house', 'turtlebot3_stage_1', 'turtlebot3_stage_2',
+                                   'turtlebot3_stage_3', 'turtlebot3_stage_4'])
+def test_the_shipped_maps_are_what_world_to_map_makes_today(world, tmp_path, capsys):
+    from tb3_sim_nav.world_to_map import main
+    assert main([world, '-f', str(tmp_path / world)]) == 0
+    assert 'world_to_map: %s -> ' % world in capsys.readouterr().out
+    for suffix in ('.pgm', '.yaml'):
+        assert (tmp_path / (world + suffix)).read_bytes() == (REPO / 'maps' / (world + suffix)).read_bytes()
+
+
+def test_world_to_map_names_a_missing_world_and_takes_a_resolution(tmp_path, capsys):
+    from tb3_sim_nav.world_to_map import main
+    assert main(['no_such_world', '-f', str(tmp_path / 'x')]) == 1
+    assert "world_to_map: world 'no_such_world': file" in capsys.readouterr().err
+    assert main(['turtlebot3_stage_1', '-f', str(tmp_path / 's'), '--resolution', '0.1', '--margin', '0.2']) == 0
+    loaded = load_map(str(tmp_path / 's.yaml'))
+    assert loaded.grid.resolution == pytest.approx(0.1) and loaded.grid.width == 46  # 4.2 m + 2 x 0.2 m
+    with pytest.raises(SystemExit):
+        main(['turtlebot3_stage_1', '-f', str(tmp_path / 's'), '--resolution', '0'])
+
+
+def test_rasterise_marks_every_cell_an_obstacle_covers_and_hardly_more():
+    """Against samples in each cell, 16 x 16 (3 mm apart: every obstacle reaching one lies more than
+    world_map.OVERLAP, 1 mm, into the cell): no covered cell missed, thin and turned walls included; and
+    every cell marked beyond those, a finer grid of samples finds covered."""
+    from tb3_sim_nav.world_file import Obstacle
+    from tb3_sim_nav.world_map import occupied
+    rng = np.random.default_rng(11)
+    grid = Grid(0.05, 44, 40, (-1.0, -1.2, 0.0))
+    obstacles = [Obstacle('box', (0.01, 1.2, 0.5), (0.3, 0.0, 0.25), 0.3, (1, 1, 1, 1), 'thin'),
+                 Obstacle('box', (0.5, 0.05, 0.5), (0.0, 0.575, 0.25), 0.0, (1, 1, 1, 1), 'on_cell_edges')]
+    for _ in range(6):
+        x, y = rng.uniform(-0.8, 1.0), rng.uniform(-1.0, 0.4)
+        obstacles.append(Obstacle('box', (rng.uniform(0.02, 0.6), rng.uniform(0.02, 0.6), 0.5), (x, y, 0.25),
+                                  rng.uniform(-3, 3), (1, 1, 1, 1), ''))
+        obstacles.append(Obstacle('cylinder', (rng.uniform(0.02, 0.3), 0.5), (y, x, 0.25), 0.0, (1, 1, 1, 1), ''))
+    def covered(cells, per_side):
+        """True per cell (n, 2) where one of per_side x per_side samples lies in an obstacle."""
+        sub = (np.arange(per_side) + 0.5) / per_side - 0.5
+        offsets = np.stack(np.meshgrid(sub, sub), -1).reshape(-1, 2) * grid.resolution
+        points = grid.centres(cells)[:, None, :] + offsets
+        return occupied(obstacles, points.reshape(-1, 2)).reshape(len(cells), -1).any(axis=1)
+
+    cells = np.stack(np.meshgrid(np.arange(grid.width), np.arange(grid.height)), -1).reshape(-1, 2)
+    marked = rasterise(obstacles, grid).ravel()
+    sampled = covered(cells, 16)
+    assert not (sampled & ~marked).any()  # nothing covered is missed
+    # What the coarse samples did not see (slivers under 3 mm) a 0.4 mm grid of samples confirms.
+    disputed = cells[marked & ~sampled]
+    assert covered(disputed, 125).all()
+    marked = marked.reshape(grid.shape)
+    # The wall 0.05 m thick on cell edges (y 0.55..0.60 on a grid from -1.2) fills one row, not three.
+    ix, iy = grid.to_cells((0.0, 0.575))
+    assert marked[iy - 1:iy + 2, ix].tolist() == [False, True, False]
+
+
+def test_signed_distance_is_negative_inside_overlapping_obstacles():
+    from tb3_sim_nav.world_file import Obstacle
+    from tb3_sim_nav.world_map import signed_distance
+    wall = Obstacle('box', (2.0, 0.4, 0.5), (0.0, 0.0, 0.25), 0.0, (1, 1, 1, 1), 'wall')
+    post = Obstacle('box', (0.2, 0.2, 0.5), (0.0, 0.25, 0.25), 0.0, (1, 1, 1, 1), 'post')  # overlaps the wall
+    # (0, -0.1): 0.1 m inside the wall, 0.05 m outside the post: inside.
+    assert signed_distance([wall, post], [(0.0, -0.1)])[0] == pytest.approx(-0.1)
+    assert signed_distance([wall, post], [(0.0, 0.4)])[0] == pytest.approx(0.05)
