@@ -136,3 +136,21 @@ def test_map_saver_without_a_map_ends_non_zero_with_one_line(node, tmp_path):
     assert not (tmp_path / 'none.pgm').exists()
     refused = run(['rosrun', 'map_server', 'map_saver', '--occ', '0'], TIMEOUT)
     assert refused.returncode == 1 and 'threshold_occupied must be between 1 and 100' in refused.stdout
+
+
+def test_the_deprecated_image_and_resolution_form_serves_the_image_at_origin_zero(node, repo_root):
+    import rospy
+    from nav_msgs.msg import OccupancyGrid
+    truth = load_map(str(repo_root / 'maps' / 'turtlebot3_world.yaml'))
+    process = Process('map_server_deprecated', [
+        'rosrun', 'map_server', 'map_server', str(repo_root / 'maps' / 'turtlebot3_world.pgm'), '0.1',
+        'map:=/old_map', 'map_metadata:=/old_map_metadata', 'static_map:=/old_static_map',
+        'change_map:=/old_change_map'], str(node))
+    try:
+        message = rospy.wait_for_message('/old_map', OccupancyGrid, timeout=TIMEOUT)
+        assert message.info.resolution == pytest.approx(0.1)
+        assert (message.info.origin.position.x, message.info.origin.position.y) == (0.0, 0.0)
+        assert np.array_equal(_values(message), truth.values)
+        assert wait_until(lambda: 'Using deprecated map server interface' in process.output(), TIMEOUT)
+    finally:
+        process.stop()
