@@ -99,6 +99,13 @@ def test_map_saver_saves_it_back_byte_for_byte(served, repo_root, tmp_path):
         assert saved == (repo_root / 'maps' / ('turtlebot3_world' + suffix)).read_bytes(), suffix
 
 
+def test_map_saver_that_cannot_write_ends_non_zero_with_one_line(served, tmp_path):
+    ended = run(['rosrun', 'map_server', 'map_saver', '-f', str(tmp_path / 'no_such_folder' / 'map')], TIMEOUT)
+    assert ended.returncode == 1
+    assert [line for line in ended.stdout.splitlines()
+            if "no_such_folder/map.pgm: couldn't save map file: No such file or directory" in line]
+
+
 def test_change_map_serves_another_and_refuses_a_missing_one(served, repo_root):
     import rospy
     from nav_msgs.msg import OccupancyGrid

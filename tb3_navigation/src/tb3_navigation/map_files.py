@@ -42,7 +42,7 @@ class MapFileError(ValueError):
     """A map file that cannot be read or written; the message names the file and the key."""
 
     def __init__(self, path, key, problem):
-        self.path, self.key = path, key
+        self.path, self.key, self.problem = path, key, problem
         where = '%s: key %r' % (path, key) if key else path
         super(MapFileError, self).__init__('%s: %s' % (where, problem))
 

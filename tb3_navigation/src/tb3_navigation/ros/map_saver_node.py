@@ -98,7 +98,7 @@ class MapSaver(object):
             try:
                 map_files.save_map(grid, values, self.config, orientation)
             except map_files.MapFileError as error:
-                rospy.logerr("Couldn't save map file to %s (%s)", error.path, error)
+                rospy.logerr('map_saver: %s', error)  # the file, then "couldn't save map file" and why
                 self.failed = True
                 return
             rospy.loginfo('Writing map occupancy data to %s.yaml', name)  # sic: the original's words
