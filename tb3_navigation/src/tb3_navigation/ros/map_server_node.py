@@ -1,4 +1,4 @@
-"""map_server as ros-planning/navigation's (noetic): `map_server MAP.yaml`, or the deprecated `map_server IMAGE RESOLUTION`.
+"""map_server as ros-planning/navigation's (noetic): `map_server MAP.yaml` (or, deprecated, `IMAGE RESOLUTION`).
 
 Publishes the map latched on `map` and its MapMetaData on `map_metadata`,
 answers `static_map` (nav_msgs/GetMap) with it and loads another on
