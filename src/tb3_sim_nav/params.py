@@ -112,7 +112,8 @@ class Config(object):
     """Every parameter of the simulator node, resolved and checked."""
     model: str = _p('burger', 'the robot (when ~robots is empty): burger, waffle, waffle_pi or the path of a URDF; its geometry, limits and cameras come from its URDF', _model)
     robots: tuple = _p((), 'robots with namespaces, instead of the one robot of ~model: a list of {name, model, position: [x, y(, z)], yaw} as in world files', _robots)
-    world: str = _p('empty', 'world by name (worlds/NAME.yaml) or path to a world file')
+    world: str = _p('empty', "world by name (worlds/NAME.yaml) or path to a world file or to a map_server map's YAML (its occupied cells become walls)")
+    map_wall_height: float = _p(0.5, 'height of the walls a map world raises on its occupied cells (above the lidar: Burger 0.182 m)', _positive, 'm')
     x_pos: float = _p(0.0, 'spawn position x', unit='m')
     y_pos: float = _p(0.0, 'spawn position y', unit='m')
     z_pos: float = _p(0.0, 'spawn height of base_footprint', unit='m')

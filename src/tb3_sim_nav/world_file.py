@@ -15,12 +15,19 @@ is that of its base_footprint (z defaults to 0), its `name` its namespace
 and tf prefix, its `model` burger, waffle, waffle_pi or the path of a URDF.
 A world named without a path ("empty", "turtlebot3_world") is a file of
 that name in the package's worlds/ folder.
+
+A map_server map (a YAML with an `image` key, as map_saver writes them) is a
+world too, as Stage makes worlds of bitmaps: its occupied cells (100) become
+walls `wall_height` tall, merged into few boxes; free and unknown cells are
+floor. So ROS by Example's test_map and a learner's own saved map are worlds
+to drive in.
 """
 import math
 import os
 import re
 from collections import namedtuple
 
+import numpy as np
 import yaml
 
 DEFAULT_COLOR = (0.75, 0.75, 0.72, 1.0)
@@ -32,8 +39,10 @@ Obstacle = namedtuple('Obstacle', 'kind size position yaw color name', defaults=
 #: `model` (burger, waffle, waffle_pi or a URDF path), `position` (x, y, z), `yaw`.
 RobotSpec = namedtuple('RobotSpec', 'name model position yaw')
 
-#: A world: its obstacles and its robots.
-WorldSpec = namedtuple('WorldSpec', 'obstacles robots')
+#: A world: its obstacles and its robots; `map` the tb3_navigation.map_files.LoadedMap it was built of, if any.
+WorldSpec = namedtuple('WorldSpec', 'obstacles robots map', defaults=(None,))
+MAP_WALL_HEIGHT = 0.5  # m: above every TurtleBot3's lidar (0.182 m on the Burger), low enough to see over in rviz
+MAP_WALL_COLOR = (0.55, 0.6, 0.65, 1.0)
 
 _SHAPE_KEYS = {'box': {'size'}, 'cylinder': {'radius', 'height'}}
 _OPTIONAL_KEYS = {'position', 'yaw', 'color', 'name'}
@@ -144,8 +153,53 @@ def parse_robots(entries, where='~robots'):
     return _parse_list(entries, _robot, 'robot', where)
 
 
-def load_world(world, worlds_folder):
-    """The WorldSpec of a world given by name or path, or WorldError."""
+def rectangles(mask):
+    """Boxes (ix, iy, columns, rows) that tile the True cells of `mask` [iy, ix]
+    exactly: each row's runs, a run merged with the same run of the rows below.
+    Whichever of rows or columns gives fewer boxes (ROS by Example's test_map:
+    2536 cells: 689 boxes by rows, 670 by columns)."""
+    def by_rows(cells):
+        growing, done = {}, []
+        for iy, row in enumerate(cells):
+            edges = np.flatnonzero(np.diff(np.concatenate(([0], row.view(np.int8), [0]))))
+            runs = set(zip(edges[::2].tolist(), edges[1::2].tolist()))
+            for run in [run for run in growing if run not in runs]:
+                done.append(tuple(growing.pop(run)))
+            for start, stop in runs:
+                if (start, stop) in growing:
+                    growing[(start, stop)][3] += 1
+                else:
+                    growing[(start, stop)] = [start, iy, stop - start, 1]
+        return sorted(done + [tuple(box) for box in growing.values()], key=lambda box: (box[1], box[0]))
+    mask = np.ascontiguousarray(mask, dtype=bool)
+    rows = by_rows(mask)
+    columns = [(iy, ix, height, width) for ix, iy, width, height in by_rows(np.ascontiguousarray(mask.T))]
+    return rows if len(rows) <= len(columns) else sorted(columns, key=lambda box: (box[1], box[0]))
+
+
+def map_obstacles(grid, occupied, wall_height=MAP_WALL_HEIGHT):
+    """Box obstacles `wall_height` tall standing on the True cells of `occupied` [iy, ix] of a grid.Grid."""
+    obstacles = []
+    for index, (ix, iy, columns, rows) in enumerate(rectangles(occupied)):
+        x, y = grid.centres((ix + (columns - 1) / 2.0, iy + (rows - 1) / 2.0))
+        obstacles.append(Obstacle('box', (columns * grid.resolution, rows * grid.resolution, wall_height),
+                                  (float(x), float(y), wall_height / 2.0), grid.origin[2], MAP_WALL_COLOR,
+                                  'wall_%d' % (index + 1)))
+    return obstacles
+
+
+def _map_world(path, wall_height):
+    from tb3_navigation.grid import OCCUPIED
+    from tb3_navigation.map_files import MapFileError, load_map
+    try:
+        loaded = load_map(path)
+    except MapFileError as error:
+        raise WorldError('world file %s is a map, and %s' % (path, error))
+    return WorldSpec(map_obstacles(loaded.grid, loaded.values == OCCUPIED, wall_height), [], loaded)
+
+
+def load_world(world, worlds_folder, map_wall_height=MAP_WALL_HEIGHT):
+    """The WorldSpec of a world given by name or path (a world file or a map YAML), or WorldError."""
     path = world_path(world, worlds_folder)
     if not os.path.isfile(path):
         raise WorldError('world %r: file %s does not exist' % (world, path))
@@ -156,6 +210,8 @@ def load_world(world, worlds_folder):
         raise WorldError('world file %s is not valid YAML: %s' % (path, error))
     if document is None:
         document = {}
+    if isinstance(document, dict) and 'image' in document:
+        return _map_world(path, map_wall_height)
     if not isinstance(document, dict) or set(document) - {'obstacles', 'robots'}:
         raise WorldError('world file %s: the top level must be a mapping with the keys '
                          '"obstacles" and "robots", not %r' % (path, sorted(document) if isinstance(document, dict)

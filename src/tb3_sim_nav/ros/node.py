@@ -291,7 +291,7 @@ def _start_up():
     try:
         config = params.resolve(lambda name, default: rospy.get_param('~' + name, default))
         package = rospkg.RosPack().get_path('tb3_sim_nav')
-        world = load_world(config.world, os.path.join(package, 'worlds'))
+        world = load_world(config.world, os.path.join(package, 'worlds'), config.map_wall_height)
         rospy.loginfo('tb3_sim parameters: %s', ', '.join('%s=%r' % (field.name, getattr(config, field.name))
                                                           for field in dataclasses.fields(config)))
         robots = []
@@ -303,7 +303,13 @@ def _start_up():
                           model.urdf_file, model.geometry.wheel_radius, model.geometry.wheel_separation,
                           config.max_linear_speed or model.limits.max_linear,
                           config.max_angular_speed or model.limits.max_angular, *(spec.position + (spec.yaw,)))
-        rospy.loginfo('tb3_sim: world %r with %d obstacles', config.world, len(world.obstacles))
+        if world.map is None:
+            rospy.loginfo('tb3_sim: world %r with %d obstacles', config.world, len(world.obstacles))
+        else:
+            grid = world.map.grid
+            rospy.loginfo('tb3_sim: world %r is a map (%d x %d at %g m): its occupied cells are %d walls '
+                          '~map_wall_height = %g m tall', config.world, grid.width, grid.height, grid.resolution,
+                          len(world.obstacles), config.map_wall_height)
         if 'TURTLEBOT3_MODEL' not in os.environ:
             rospy.loginfo('tb3_sim: TURTLEBOT3_MODEL is not set: the launch gave model %s (burger unless model:= '
                           'says otherwise; export TURTLEBOT3_MODEL=burger, waffle or waffle_pi to choose)', config.model)
