@@ -11,6 +11,7 @@ from PIL import Image
 
 from tb3_navigation import map_files
 from tb3_navigation.grid import Grid
+from tb3_navigation.pose2d import quaternion_of_yaw
 from tb3_navigation.map_files import MapFileError, SaverConfig
 
 from conftest import REPO
@@ -133,7 +134,7 @@ def test_the_yaml_yaw_is_tf2s_yaw_of_the_origin_quaternion():
         assert map_files.yaw_of_quaternion(*q) == pytest.approx(euler_from_quaternion(q)[2], abs=1e-12)
         # Not normalised: tf2's Matrix3x3 scales by 2 / |q|^2.
         assert map_files.yaw_of_quaternion(*(2.0 * q)) == pytest.approx(yaw, abs=1e-12)
-    text = map_files.yaml_text('m.pgm', 0.05, (1.0, 2.0), map_files.quaternion_of_yaw(0.785398))
+    text = map_files.yaml_text('m.pgm', 0.05, (1.0, 2.0), quaternion_of_yaw(0.785398))
     assert 'origin: [1.000000, 2.000000, 0.785398]' in text
 
 

@@ -31,6 +31,7 @@ import numpy as np
 import yaml
 
 from .grid import Grid
+from .pose2d import quaternion_of_yaw
 
 TRINARY, SCALE, RAW = 'trinary', 'scale', 'raw'
 MODES = (TRINARY, SCALE, RAW)
@@ -230,11 +231,6 @@ def yaw_of_quaternion(x, y, z, w):
         return 0.0
     cos_pitch = math.cos(-math.asin(m20))
     return math.atan2(m10 / cos_pitch, m00 / cos_pitch)
-
-
-def quaternion_of_yaw(yaw):
-    """(x, y, z, w) as map_server makes it: btQuaternion.setEulerZYX(yaw, 0, 0)."""
-    return 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)
 
 
 def pgm_bytes(values, resolution, threshold_occupied=65, threshold_free=25):

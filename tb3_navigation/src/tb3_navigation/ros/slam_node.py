@@ -22,8 +22,9 @@ from sensor_msgs.msg import LaserScan
 
 from ..scan import Scan
 from ..slam import Slam, SlamConfig
-from . import config, grids, lifecycle
+from . import config, lifecycle
 from .frames import Frames, namespaced
+from .map_messages import occupancy_grid
 
 NODE = 'tb3_slam'
 #: What turtlebot3_slam.launch's slam_methods may ask for: each runs this node (and says so).
@@ -94,7 +95,7 @@ class SlamNode(object):
             due = (self._last_map_stamp is None
                    or (stamp - self._last_map_stamp).to_sec() > self.config.map_update_interval)
             if due and self.slam.map_updates != self._published_updates:
-                self._map = grids.to_message(self.slam.grid, self.slam.map_values(), self.map_frame, stamp)
+                self._map = occupancy_grid(self.slam.grid, self.slam.map_values(), self.map_frame, stamp)
                 self._published_updates, self._last_map_stamp = self.slam.map_updates, stamp
                 self.map_pub.publish(self._map)
                 self.metadata_pub.publish(self._map.info)
@@ -122,7 +123,7 @@ class SlamNode(object):
     def _on_dynamic_map(self, _request):
         with self._lock:
             if self._map is None:
-                self._map = grids.to_message(self.slam.grid, self.slam.map_values(), self.map_frame,
+                self._map = occupancy_grid(self.slam.grid, self.slam.map_values(), self.map_frame,
                                              rospy.Time.now())
             return GetMapResponse(map=self._map)
 
