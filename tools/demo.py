@@ -6,6 +6,12 @@ calibration scripts measured against ground truth, the corrections set with
 dynparam, odom_out_and_back.py again; table in OUTPUT/calibration.txt, paths in
 OUTPUT/calibration_paths.png.
 
+With --slam (`make demo DEMO_ARGS="--slam"`) it maps turtlebot3_world
+(tb3_harness/mapping.py): tb3_world.launch (profile realistic), tb3_slam.launch,
+a drive around the pillars, map_saver; the map in OUTPUT/map.yaml and .pgm, a
+table in OUTPUT/slam.txt and the map under the world's outline with the paths
+in OUTPUT/slam_map.png. As fast as possible unless --real-time-factor says.
+
 Run inside `source setup.bash`. Starts one master on a free loopback port, then
 for each script does what the tutorial does: start the simulator fresh
 (`roslaunch tb3_sim_bringup tb3_empty_world.launch`), wait for odom ->
@@ -29,7 +35,7 @@ import subprocess
 import sys
 import time
 
-from tb3_harness import calibration, leftovers, report
+from tb3_harness import calibration, leftovers, mapping, report
 from tb3_harness.processes import RunError, say, start_master
 from tb3_harness.tutorial import LAUNCH, SCRIPTS, run_script
 from tb3_sim_nav.robot_model import TURTLEBOT3_MODELS
@@ -44,8 +50,8 @@ class Interrupted(BaseException):
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--real-time-factor', type=float, default=1.0, metavar='F',
-                        help='launch arg real_time_factor (default 1.0; 0 = as fast as possible)')
+    parser.add_argument('--real-time-factor', type=float, metavar='F',
+                        help='launch arg real_time_factor (default 1.0; --slam: 0 = as fast as possible)')
     parser.add_argument('--profile', metavar='NAME',
                         help='launch arg profile (passed only if given)')
     parser.add_argument('--model', choices=TURTLEBOT3_MODELS,
@@ -56,7 +62,15 @@ def parse_args(argv):
                         help='run only these scripts (default: all three, in the tutorial\'s order)')
     parser.add_argument('--calibrate', action='store_true',
                         help='the calibration walkthrough (profile realistic) instead of the tutorial\'s scripts')
+    parser.add_argument('--slam', action='store_true',
+                        help='map turtlebot3_world (profile realistic) and save the map, instead of the tutorial')
     args = parser.parse_args(argv)
+    if args.calibrate + args.slam > 1:
+        parser.error('--calibrate and --slam are walkthroughs of their own: one at a time')
+    if args.slam and (args.scripts or args.profile not in (None, 'realistic')):
+        parser.error('--slam drives its own route in profile realistic: no --scripts, no other --profile')
+    if args.real_time_factor is None:
+        args.real_time_factor = 0.0 if args.slam else 1.0
     if args.calibrate and (args.scripts or args.profile not in (None, 'realistic')):
         parser.error('--calibrate runs its own scripts in profile realistic: no --scripts, no other --profile')
     if not args.real_time_factor >= 0.0:
@@ -106,7 +120,7 @@ def main(argv=None):
     signal.signal(signal.SIGTERM, on_sigterm)
     signal.signal(signal.SIGINT, signal.default_int_handler)  # even if started with SIGINT ignored
 
-    calibrated = None
+    calibrated = mapped = None
     scripts = [(name, expected) for name, expected in SCRIPTS if not args.scripts or name in args.scripts]
     master = None
     results, failures = [], []
@@ -121,7 +135,9 @@ def main(argv=None):
             raise RunError('the demo node did not pick up /use_sim_time')
         if args.calibrate:
             calibrated = calibration.calibrate(args.real_time_factor, log_dir)
-        for script, expected in scripts if not args.calibrate else ():
+        if args.slam:
+            mapped = mapping.map_world(log_dir, args.output, factor=args.real_time_factor)
+        for script, expected in scripts if not (args.calibrate or args.slam) else ():
             result, error = run_script(script, expected, args, log_dir)
             results.append(result)
             if error:
@@ -145,6 +161,14 @@ def main(argv=None):
     total = time.monotonic() - _T0
     if calibrated is not None:
         write_calibration(args, calibrated, total)
+    if mapped is not None:
+        text = '\n'.join(mapping.table(mapped) + ['', 'total wall time %.1f s' % total])
+        print('\n' + text, flush=True)
+        with open(os.path.join(args.output, 'slam.txt'), 'w') as summary:
+            summary.write(text + '\n')
+        mapping.draw(mapped, os.path.join(args.output, 'slam_map.png'))
+        say('wrote %s, %s and %s' % (mapped.map_yaml, os.path.join(args.output, 'slam.txt'),
+                                     os.path.join(args.output, 'slam_map.png')))
     model = args.model or os.environ.get('TURTLEBOT3_MODEL', 'burger')
     if results:
         header = ['tb3_sim_nav demo: the tutorial\'s scripts on the pybullet TurtleBot3 %s' % model,
@@ -170,6 +194,10 @@ def main(argv=None):
     if calibrated is not None:
         say('demo done: calibration walkthrough complete')
         return 0
+    if mapped is not None:
+        missed = mapped.quality.failures()
+        say('demo done: turtlebot3_world mapped%s' % ('; MISSED: ' + '; '.join(missed) if missed else ''))
+        return 1 if missed else 0
     say('demo done: %d scripts, all exited 0' % len(results))
     return 0
 
