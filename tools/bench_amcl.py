@@ -57,7 +57,8 @@ def main():
              platform.python_version(), np.__version__))
     drive = record_drive('turtlebot3_world', WORLD_LOOP_START, WORLD_LOOP)
     world = world_grid('turtlebot3_world')
-    print('loop: %d scans at 5 Hz, 13.6 m; 180 of 360 beams, those under 3.5 m (~163) weighed; ms of CPU per update, lik. = of it the likelihood\n' % len(drive.times))
+    print('loop: %d scans at 5 Hz, 13.6 m; 180 of 360 beams, those under 3.5 m (~163) weighed' % len(drive.times))
+    print('ms of CPU per filter update; lik. = its likelihood part\n')
     print('%-34s %8s %8s %10s %10s %s' % ('case', 'updates', 'ms med', 'ms p95', 'lik. med', 'particles min/med/max'))
     cases = [('fixed 500 particles, tracking', dict(min_particles=500, max_particles=500), TIGHT, 0.0),
              ('fixed 3000 particles, tracking', dict(min_particles=3000, max_particles=3000), TIGHT, 0.0),
