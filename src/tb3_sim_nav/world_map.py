@@ -168,11 +168,11 @@ def ray_cast(obstacles, origin, angles, max_range=math.inf):
             for start, step, half in ((x[0], dx, obstacle.size[0] / 2.0), (y[0], dy, obstacle.size[1] / 2.0)):
                 with np.errstate(divide='ignore', invalid='ignore'):
                     first, second = (-half - start) / step, (half - start) / step
+                # A ray parallel to this pair of faces is inside the slab all along, or never.
+                inside = abs(start) <= half
                 parallel = step == 0.0
-                first = np.where(parallel, np.where(abs(start) <= half, -np.inf, np.inf), first)
-                second = np.where(parallel, np.where(abs(start) <= half, np.inf, -np.inf), second)
-                near = np.maximum(near, np.minimum(first, second))
-                far = np.minimum(far, np.maximum(first, second))
+                near = np.maximum(near, np.where(parallel, -np.inf if inside else np.inf, np.minimum(first, second)))
+                far = np.minimum(far, np.where(parallel, np.inf if inside else -np.inf, np.maximum(first, second)))
             hit = np.where((near <= far) & (far >= 0.0), np.maximum(near, 0.0), np.inf)
         else:
             along = -(x[0] * dx + y[0] * dy)

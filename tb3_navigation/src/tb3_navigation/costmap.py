@@ -216,8 +216,8 @@ class Costmap(object):
             return master
         inflated = inflation_costs(distance_transform_edt(~lethal), self.grid.resolution, self.inscribed_radius,
                                    config.inflation_radius, config.cost_scaling_factor)
-        keep_unknown = (master == NO_INFORMATION) & (inflated < INSCRIBED_INFLATED_OBSTACLE)
-        return np.where(keep_unknown, master, np.maximum(master, inflated))
+        unknown_value = np.where(inflated >= INSCRIBED_INFLATED_OBSTACLE, inflated, NO_INFORMATION)
+        return np.where(master == NO_INFORMATION, unknown_value, np.maximum(master, inflated))
 
     def clear_obstacles(self, centre, size, inside=False):
         """clear_costmap_recovery: forget the obstacle layer's cells outside (or, with
