@@ -178,6 +178,17 @@ def test_rolling_window_follows_the_robot_in_whole_cells_and_keeps_marks_in_plac
     assert np.all(costmap.cost_at(marked) == FREE_SPACE)
 
 
+def test_rolling_window_clears_beams_up_to_its_edge():
+    costmap = Costmap.rolling(CostmapConfig(inflation_radius=0.0))
+    # A mark one cell before the window's edge, on the beam ahead (the edge cell itself is the
+    # cut beam's end cell, which costmap_2d's raytraceLine leaves as it is too).
+    edge = costmap.grid.to_cells(np.array([1.42, 0.01]))
+    costmap.obstacles[edge[1], edge[0]] = LETHAL_OBSTACLE
+    scan_update(costmap, (0.0, 0.0, 0.0), [box(3.1, 0.0, 0.1, 0.4)])  # a hit 3 m ahead, far outside
+    assert costmap.obstacles[edge[1], edge[0]] == FREE_SPACE
+    assert not np.any(costmap.costs == LETHAL_OBSTACLE)
+
+
 # --- the footprint's cost -------------------------------------------------------------------
 
 def test_footprint_cost_is_the_highest_cost_under_its_outline_and_refuses_lethal_unknown_and_off_map():
