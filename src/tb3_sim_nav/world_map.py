@@ -179,6 +179,7 @@ def ray_cast(obstacles, origin, angles, max_range=math.inf):
             chord = along * along - (x[0] * x[0] + y[0] * y[0] - obstacle.size[0] ** 2)
             root = np.sqrt(np.maximum(chord, 0.0))
             entry = along - root
-            hit = np.where(chord < 0.0, np.inf, np.where(entry >= 0.0, entry, np.where(along + root >= 0.0, 0.0, np.inf)))
+            inside = (entry < 0.0) & (along + root >= 0.0)  # the origin within the circle: a hit at once
+            hit = np.where(chord < 0.0, np.inf, np.where(entry >= 0.0, entry, np.where(inside, 0.0, np.inf)))
         nearest = np.minimum(nearest, hit)
     return np.where(nearest <= max_range, nearest, np.inf)

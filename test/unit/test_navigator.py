@@ -9,7 +9,7 @@ import pytest
 from tb3_navigation.controller import Command, DwaController, dwa_config
 from tb3_navigation.costmap import BURGER_FOOTPRINT
 from tb3_navigation.navigator import (ABORTED, CLEARING, CONTROLLING, PLANNING, PREEMPTED, STOP, SUCCEEDED,
-                                      Navigator, NavigatorConfig, goal_error)
+                                      Navigator, NavigatorConfig, RotateRecoveryConfig, goal_error)
 from tb3_navigation.planner import GlobalPlanner
 from tb3_navigation.pose2d import compose, quaternion_of_yaw
 from tb3_sim_nav.world_file import Obstacle
@@ -198,7 +198,7 @@ def test_rotate_recovery_turns_a_full_turn_left_within_its_limits():
                 break
             speeds.append(step.cmd[1])
             turned += step.cmd[1] * PERIOD
-    assert 2 * math.pi - 0.1 - 0.11 <= turned <= 2 * math.pi + 0.1 + 0.11
+    assert 2 * math.pi - 0.1 - 1e-9 <= turned <= 2 * math.pi + 0.1  # back within its yaw_goal_tolerance
     assert min(speeds) >= 0.4 and max(speeds) <= 1.0
     assert run.navigator.state == PLANNING
 
@@ -296,6 +296,10 @@ def test_config_validation_names_the_parameter():
         NavigatorConfig(controller_frequency=0.0)
     with pytest.raises(ValueError, match='recovery_behaviors'):
         NavigatorConfig(recovery_behaviors=('conservative_reset', 'dance'))
+    with pytest.raises(ValueError, match='global_frame'):
+        NavigatorConfig(global_frame='')
+    with pytest.raises(ValueError, match='rotate_recovery: sim_granularity'):
+        RotateRecoveryConfig(sim_granularity=0.0)
 
 
 # --- the whole stack in turtlebot3_world ----------------------------------------------------

@@ -206,8 +206,9 @@ class Costmap(object):
     def _follow(self, robot_pose):
         """Move the window so the robot is at its centre, in whole cells (Costmap2D::updateOrigin)."""
         grid = self.grid
-        wanted = (robot_pose[0] - grid.width * grid.resolution / 2.0, robot_pose[1] - grid.height * grid.resolution / 2.0)
-        shift = [int((wanted[axis] - grid.origin[axis]) / grid.resolution) for axis in (0, 1)]  # C's truncation
+        size = (grid.width * grid.resolution, grid.height * grid.resolution)
+        shift = [int((robot_pose[axis] - size[axis] / 2.0 - grid.origin[axis]) / grid.resolution)  # C's truncation
+                 for axis in (0, 1)]
         if shift == [0, 0]:
             return
         moved = np.full(grid.shape, self._default, dtype=np.uint8)

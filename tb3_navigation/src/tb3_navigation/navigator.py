@@ -26,18 +26,17 @@ cannot be brought into the global frame is ABORTED at once. After any end,
 the next step commands a stop (move_base's publishZeroVelocity), then None
 while idle: the node sends nothing then and leaves the robot to others.
 
-The rotation is a behaviour of several steps here: move_base runs it to
-its end inside one cycle; here goals and cancels still come through while
-it turns. It stops when the footprint would hit something along the turn
-that is left (as rotate_recovery's check), and, an addition, after
-rotation_timeout s, so that a robot that cannot turn does not wait forever.
+The rotation (tb3_navigation.recovery) takes several steps here: move_base
+runs it to its end inside one cycle; here goals and cancels still come
+through while it turns.
 """
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from tb3_navigation.pose2d import IDENTITY, compose, normalize_angle, yaw_of_quaternion
+from tb3_navigation.pose2d import IDENTITY, compose, yaw_of_quaternion
+from tb3_navigation.recovery import RotateRecovery, RotateRecoveryConfig
 
 PENDING, PREEMPTED, SUCCEEDED, ABORTED = 0, 2, 3, 4  # actionlib_msgs/GoalStatus
 PLANNING, CONTROLLING, CLEARING = 'PLANNING', 'CONTROLLING', 'CLEARING'
@@ -48,17 +47,6 @@ ABORT_TEXT = {  # move_base's words
     OSCILLATION_R: 'Robot is oscillating. Even after executing recovery behaviors.'}
 STOP = (0.0, 0.0)
 DEFAULT_RECOVERIES = ('conservative_reset', 'rotate_recovery', 'aggressive_reset', 'rotate_recovery')
-
-
-@dataclass(frozen=True)
-class RotateRecoveryConfig:
-    """rotate_recovery's parameters. It reads them under TrajectoryPlannerROS, which
-    TurtleBot3's move_base.launch does not load, so its defaults hold."""
-    sim_granularity: float = 0.017
-    acc_lim_theta: float = 3.2
-    max_vel_theta: float = 1.0
-    min_in_place_vel_theta: float = 0.4
-    yaw_goal_tolerance: float = 0.10
 
 
 @dataclass(frozen=True)
@@ -89,6 +77,8 @@ class NavigatorConfig:
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
                     or value < 0:
                 raise ValueError('%s must be a finite number >= 0, not %r' % (name, value))
+        if not isinstance(self.global_frame, str) or not self.global_frame.strip('/'):
+            raise ValueError('global_frame must be a frame name, not %r' % (self.global_frame,))
         if not self.controller_frequency > 0:
             raise ValueError('controller_frequency must be > 0, not %r' % (self.controller_frequency,))
         unknown = [name for name in self.recovery_behaviors if name not in
@@ -237,8 +227,8 @@ class Navigator(object):
                 and np.all(np.isfinite(global_to_local))):
             return Step(STOP, self.state)  # nothing to steer by: hold still, time goes on
         config = self.config
-        if self._oscillation_pose is None or math.hypot(pose[0] - self._oscillation_pose[0],
-                                                        pose[1] - self._oscillation_pose[1]) >= config.oscillation_distance:
+        last = self._oscillation_pose
+        if last is None or math.hypot(pose[0] - last[0], pose[1] - last[1]) >= config.oscillation_distance:
             self._last_oscillation_reset, self._oscillation_pose = now, tuple(pose)
             if self._trigger == OSCILLATION_R:
                 self._recovery_index = 0
@@ -308,7 +298,7 @@ class Navigator(object):
                      if config.clearing_rotation_allowed or name != 'rotate_recovery')
 
     def _clear(self, now, pose, global_to_local, new_plan):
-        started = None
+        started, local = None, compose(global_to_local, pose)  # the rotation is watched in the local frame
         if self._behaviour is None:
             behaviours = self._behaviours()
             if self._recovery_index >= len(behaviours):
@@ -316,17 +306,18 @@ class Navigator(object):
             started = behaviours[self._recovery_index]
             self._recovery_index += 1
             if started == 'rotate_recovery':
-                self._behaviour = dict(start=pose[2], half=False, since=now)
+                self._behaviour = RotateRecovery(self.config.rotate_recovery, now, local[2],
+                                                 self.config.rotation_timeout)
             else:
                 size = (self.config.conservative_reset_dist if started == 'conservative_reset'
                         else 4.0 * self.config.circumscribed_radius)
-                for costmap, centre in ((self.global_costmap, pose),
-                                        (self.local_costmap, compose(global_to_local, pose))):
+                for costmap, centre in ((self.global_costmap, pose), (self.local_costmap, local)):
                     if costmap is not None:
                         costmap.clear_obstacles(centre[:2], size)
                 self._back_to_planning(now)
                 return Step(STOP, CLEARING, plan=new_plan, recovery=started)
-        cmd = self._rotate(now, pose, global_to_local)
+        footprint_cost = None if self.local_costmap is None else self.local_costmap.footprint_cost
+        cmd = self._behaviour.command(now, local, footprint_cost)
         if cmd is None:
             self._behaviour = None
             self._back_to_planning(now)
@@ -336,27 +327,3 @@ class Navigator(object):
     def _back_to_planning(self, now):
         self._last_oscillation_reset = self._last_valid_plan = self._next_plan = now
         self._retries, self.state = 0, PLANNING
-
-    def _rotate(self, now, pose, global_to_local):
-        """rotate_recovery's command for this cycle, or None when the turn is over."""
-        config, behaviour = self.config.rotate_recovery, self._behaviour
-        yaw, start = pose[2], behaviour['start']
-        if behaviour['half'] and abs(normalize_angle(yaw - start)) <= config.yaw_goal_tolerance:
-            return None
-        if now > behaviour['since'] + self.config.rotation_timeout:
-            return None
-        if not behaviour['half']:
-            to_half = abs(normalize_angle(yaw - (start + math.pi)))
-            left = math.pi + to_half
-            behaviour['half'] = to_half < config.yaw_goal_tolerance
-        else:
-            left = abs(normalize_angle(yaw - start))
-        if self.local_costmap is not None:
-            local = compose(global_to_local, pose)
-            angles = local[2] + np.arange(0.0, left, config.sim_granularity)
-            poses = np.stack((np.full_like(angles, local[0]), np.full_like(angles, local[1]), angles), axis=-1)
-            if len(poses) and np.any(self.local_costmap.footprint_cost(poses) < 0):
-                return None
-        speed = min(max(math.sqrt(2.0 * config.acc_lim_theta * left), config.min_in_place_vel_theta),
-                    config.max_vel_theta)
-        return (0.0, float(speed))

@@ -63,8 +63,8 @@ class TrajectoryScorer(object):
         near_goal = np.hypot(*(goal - pose[:2])) <= config.forward_point_distance
         scale_path = config.path_distance_bias * grid.resolution
         scale_goal = config.goal_distance_bias * grid.resolution
-        path = _steps_from(costmap, blocked, _plan_cells(costmap, dense))
-        return dict(path=path, goal=_steps_from(costmap, blocked, _plan_cells(costmap, dense)[-1:]),
+        cells = _plan_cells(costmap, dense)
+        return dict(path=_steps_from(costmap, blocked, cells), goal=_steps_from(costmap, blocked, cells[-1:]),
                     front=_steps_from(costmap, blocked, _plan_cells(costmap, front)[-1:]),
                     scale_path=scale_path, scale_goal=scale_goal,
                     scale_alignment=0.0 if near_goal else scale_path)
@@ -103,9 +103,10 @@ class TrajectoryScorer(object):
             rejected |= off | (stop & (values >= maps[name].size))
             costs += scale * np.where(off, 0.0, values)
         costs[rejected] = -1.0
-        # The footprints last, cheapest trajectories first: a trajectory's obstacle
-        # term is at most occdist_scale * 254, so once the cheapest unchecked one costs
-        # more than the best total found, no later one can win.
+        # The footprints last, cheapest trajectories first: the obstacle term is never
+        # negative, so once the other terms of the cheapest unchecked trajectory alone
+        # cost more than the best total found, no later one can win (an equal one is
+        # still checked: among equals the first sampled wins).
         order = np.flatnonzero(~rejected)
         order = order[np.argsort(costs[order], kind='stable')]
         best = math.inf
@@ -137,6 +138,7 @@ class TrajectoryScorer(object):
             per_pose = np.where(footprint < 0, -1.0, np.maximum(footprint, centre)).reshape(len(rows), steps)
             result[rows] = np.where(np.any(per_pose < 0, axis=1), -1.0, per_pose.max(axis=1))
         return result
+
 
 def _densify(points, resolution):
     """MapGrid::adjustPlanResolution: points inserted so that none is more than `resolution` from the next."""
