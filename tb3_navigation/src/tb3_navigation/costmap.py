@@ -45,6 +45,14 @@ FREE_SPACE, INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE, NO_INFORMATION = 0, 25
 BURGER_FOOTPRINT = ((-0.105, -0.105), (-0.105, 0.105), (0.041, 0.105), (0.041, -0.105))
 WAFFLE_FOOTPRINT = ((-0.205, -0.155), (-0.205, 0.155), (0.077, 0.155), (0.077, -0.155))
 
+#: For the node around the core: turtlebot3_navigation/param/global_costmap_params.yaml and
+#: local_costmap_params.yaml (noetic), the costmaps' frames, rates and windows.
+GLOBAL_COSTMAP = dict(global_frame='map', robot_base_frame='base_footprint', update_frequency=10.0,
+                      publish_frequency=10.0, transform_tolerance=0.5, static_map=True)
+LOCAL_COSTMAP = dict(global_frame='odom', robot_base_frame='base_footprint', update_frequency=10.0,
+                     publish_frequency=10.0, transform_tolerance=0.5, static_map=False, rolling_window=True,
+                     width=3.0, height=3.0, resolution=0.05)
+
 #: costmap_2d's publisher: costs to OccupancyGrid values (0, 1..98, 99 inscribed, 100 lethal, -1 unknown).
 TRANSLATION = np.array([0] + [1 + (97 * (cost - 1)) // 251 for cost in range(1, 253)] + [99, 100, -1], dtype=np.int8)
 
