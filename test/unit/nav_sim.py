@@ -3,16 +3,15 @@
 A unicycle with TurtleBot3's acceleration limits stands for the Burger, a
 2-D ray cast of a world's cut at the lidar's height (tb3_sim_nav.world_map)
 for its LDS-01 (360 beams, 0.12-3.5 m, sigma 0.01 m, seeded), and the map is
-the cut drawn on a grid (occupied where a cell's centre lies inside an
-obstacle, as the shipped maps are made). The odom frame is set off from the
-map frame, so that the cores meet two frames as on the robot.
+the cut as world_map.map_of_world draws it for the shipped maps. The odom
+frame is set off from the map frame, so that the cores meet two frames as on
+the robot.
 """
 import math
 
 import numpy as np
 
 from tb3_navigation.costmap import Costmap, CostmapConfig
-from tb3_navigation.grid import Grid
 from tb3_navigation.pose2d import compose, inverse
 from tb3_navigation.scan import Scan
 from tb3_sim_nav import world_map
@@ -28,13 +27,6 @@ MAP_IN_ODOM = (0.3, -0.2, 0.1)  # the map frame's pose in odom: any fixed offset
 def world_cut(world='turtlebot3_world'):
     """The obstacles of a world file that the Burger's lidar plane cuts."""
     return world_map.in_plane(load_world(world, str(REPO / 'worlds')).obstacles)
-
-
-def map_of(obstacles, resolution=0.05, margin=0.5):
-    """(grid, OccupancyGrid values [iy, ix]) of the cut: 100 inside an obstacle, 0 elsewhere."""
-    grid = Grid.around(resolution, *world_map.bounds(obstacles, margin))
-    inside = world_map.occupied(obstacles, grid.all_centres().reshape(-1, 2)).reshape(grid.shape)
-    return grid, np.where(inside, 100, 0).astype(np.int8)
 
 
 class Unicycle(object):
@@ -80,7 +72,7 @@ class Lidar(object):
 
 def costmaps(obstacles, start, config=CostmapConfig()):
     """(global costmap in map from the cut's map, local rolling 3 x 3 m costmap in odom)."""
-    grid, data = map_of(obstacles)
+    grid, data = world_map.map_of_world(obstacles)
     local_start = compose(MAP_IN_ODOM, start)
     return Costmap(grid, config, static=data), Costmap.rolling(config, centre=local_start[:2])
 

@@ -11,7 +11,7 @@ from tb3_navigation.grid import Grid
 from tb3_navigation.planner import GlobalPlanner, PlannerConfig, plan_length
 from tb3_sim_nav import world_map
 
-from nav_sim import map_of, world_cut
+from nav_sim import world_cut
 
 PILLARS = [(x, y) for x in (-1.1, 0.0, 1.1) for y in (-1.1, 0.0, 1.1)]
 PILLAR_RADIUS = 0.15
@@ -20,7 +20,7 @@ PILLAR_RADIUS = 0.15
 @pytest.fixture(scope='module')
 def world():
     obstacles = world_cut()
-    grid, data = map_of(obstacles)
+    grid, data = world_map.map_of_world(obstacles)
     return obstacles, Costmap(grid, CostmapConfig(), static=data)
 
 
