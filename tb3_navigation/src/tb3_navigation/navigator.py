@@ -31,7 +31,7 @@ runs it to its end inside one cycle; here goals and cancels still come
 through while it turns.
 """
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -51,7 +51,9 @@ DEFAULT_RECOVERIES = ('conservative_reset', 'rotate_recovery', 'aggressive_reset
 
 @dataclass(frozen=True)
 class NavigatorConfig:
-    """move_base's parameters: TurtleBot3's move_base_params.yaml, move_base's defaults for the rest."""
+    """move_base's parameters: TurtleBot3's move_base_params.yaml, move_base's defaults for the rest.
+    recovery_behaviors names the behaviours in order (move_base's list gives {name, type}
+    each: the node passes the names of the clear_costmap_recovery and rotate_recovery ones)."""
     global_frame: str = 'map'
     controller_frequency: float = 10.0
     planner_frequency: float = 5.0
@@ -67,7 +69,7 @@ class NavigatorConfig:
     recovery_behaviors: tuple = DEFAULT_RECOVERIES
     quaternion_norm_tolerance: float = 1e-3
     rotation_timeout: float = 30.0
-    rotate_recovery: RotateRecoveryConfig = field(default_factory=RotateRecoveryConfig)
+    rotate_recovery: RotateRecoveryConfig = RotateRecoveryConfig()  # frozen: one shared default is safe
 
     def __post_init__(self):
         for name in ('controller_frequency', 'planner_frequency', 'planner_patience', 'controller_patience',
