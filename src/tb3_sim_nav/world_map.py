@@ -151,3 +151,35 @@ def map_of_world(obstacles, resolution=0.05, margin=0.5, height=BURGER_SCAN_HEIG
     xmin, ymin = (round(math.floor(value / resolution) * resolution, 9) for value in (xmin, ymin))
     grid = Grid.around(resolution, xmin, ymin, xmax, ymax)
     return grid, np.where(rasterise(cut, grid), OCCUPIED, FREE).astype(np.int8)
+
+
+def ray_cast(obstacles, origin, angles, max_range=math.inf):
+    """Distance (n,) along each ray from `origin` (x, y) at `angles` (n,) (rad, in the
+    frame) to the first obstacle outline it meets; inf if none within `max_range`.
+    What a planar lidar at `origin` would read of the cut, without noise."""
+    angles = np.asarray(angles, dtype=float).reshape(-1)
+    nearest = np.full(angles.size, np.inf)
+    for obstacle in obstacles:
+        x, y = _local(obstacle, np.asarray(origin, dtype=float).reshape(1, 2))
+        heading = angles - obstacle.yaw
+        dx, dy = np.cos(heading), np.sin(heading)
+        if obstacle.kind == 'box':
+            near, far = np.full(angles.size, -np.inf), np.full(angles.size, np.inf)
+            for start, step, half in ((x[0], dx, obstacle.size[0] / 2.0), (y[0], dy, obstacle.size[1] / 2.0)):
+                with np.errstate(divide='ignore', invalid='ignore'):
+                    first, second = (-half - start) / step, (half - start) / step
+                # A ray parallel to this pair of faces is inside the slab all along, or never.
+                inside = abs(start) <= half
+                parallel = step == 0.0
+                near = np.maximum(near, np.where(parallel, -np.inf if inside else np.inf, np.minimum(first, second)))
+                far = np.minimum(far, np.where(parallel, np.inf if inside else -np.inf, np.maximum(first, second)))
+            hit = np.where((near <= far) & (far >= 0.0), np.maximum(near, 0.0), np.inf)
+        else:
+            along = -(x[0] * dx + y[0] * dy)
+            chord = along * along - (x[0] * x[0] + y[0] * y[0] - obstacle.size[0] ** 2)
+            root = np.sqrt(np.maximum(chord, 0.0))
+            entry = along - root
+            inside = (entry < 0.0) & (along + root >= 0.0)  # the origin within the circle: a hit at once
+            hit = np.where(chord < 0.0, np.inf, np.where(entry >= 0.0, entry, np.where(inside, 0.0, np.inf)))
+        nearest = np.minimum(nearest, hit)
+    return np.where(nearest <= max_range, nearest, np.inf)

@@ -1,0 +1,99 @@
+"""Shortest paths over the cells of a grid, at C speed (scipy's Dijkstra). No ROS here.
+
+A grid of H x W cells is a graph whose edges join each cell to its 4 or 8
+neighbours; stepping into cell c costs `step_costs[c]` times the step's
+length (1, or sqrt(2) for a diagonal), and a cell whose step cost is inf
+cannot be entered. The global planner uses it with navfn's cell costs
+(8 neighbours, from the robot's cell); the controller with unit costs
+(4 neighbours, cells away from the plan, as base_local_planner's MapGrid).
+
+The edges' layout depends on the grid's shape only, so it is built once per
+shape and kept; a graph then costs one pass of numpy over the edges (11 ms
+for 400 x 260 cells, 0.83 M edges). scipy's Dijkstra has no A*, but A* is
+Dijkstra over edges reweighted by a consistent heuristic h (w + h(target) -
+h(source) >= 0), which `build` makes given h; a search over it bounded by
+`limit` visits only the cells whose cost so far plus h stays within it.
+"""
+import functools
+import math
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+
+UNREACHED = -9999  # scipy's predecessor of a source or of a cell no path reaches
+
+
+@functools.lru_cache(maxsize=8)
+def _edges(shape, connectivity):
+    """(indptr, targets, lengths, sides, sources) of every edge of a `shape` grid,
+    sorted by source: sides (2, E) are, for a diagonal edge, the two cells it
+    passes between (for a straight edge, its target twice)."""
+    if connectivity not in (4, 8):
+        raise ValueError('connectivity must be 4 or 8, not %r' % (connectivity,))
+    height, width = shape
+    index = np.arange(height * width).reshape(shape)
+    sources, targets, lengths, sides = [], [], [], []
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            if (dx, dy) == (0, 0) or (connectivity == 4 and dx and dy):
+                continue
+            rows = slice(max(0, -dy), height - max(0, dy))
+            columns = slice(max(0, -dx), width - max(0, dx))
+            source = index[rows, columns]
+            target = index[rows.start + dy:rows.stop + dy, columns.start + dx:columns.stop + dx]
+            sources.append(source.ravel())
+            targets.append(target.ravel())
+            lengths.append(np.full(source.size, math.hypot(dx, dy)))
+            # A diagonal step passes between (y + dy, x) and (y, x + dx).
+            sides.append(np.stack(((source + dy * width).ravel(), (source + dx).ravel())) if dx and dy
+                         else np.stack((target.ravel(), target.ravel())))
+    sources = np.concatenate(sources)
+    order = np.argsort(sources, kind='stable')
+    indptr = np.searchsorted(sources[order], np.arange(height * width + 1)).astype(np.int32)
+    return (indptr, np.concatenate(targets)[order].astype(np.int32), np.concatenate(lengths)[order],
+            np.concatenate(sides, axis=1)[:, order], sources[order])
+
+
+def build(step_costs, connectivity=8, heuristic=None):
+    """The graph (scipy CSR, cells as nodes) of a grid whose cells cost `step_costs`
+    (H, W) to step into. A diagonal step needs both cells it passes between to be
+    enterable, so that no path slips through a wall drawn as a diagonal line of
+    cells. With a `heuristic` (H, W), a consistent estimate of the cost left from
+    each cell, the weights are A*'s: w + h(target) - h(source), rounding errors
+    clipped at 0."""
+    step_costs = np.asarray(step_costs, dtype=float)
+    indptr, targets, lengths, sides, sources = _edges(step_costs.shape, connectivity)
+    flat = step_costs.ravel()
+    weights = flat[targets] * lengths
+    if heuristic is not None:
+        estimate = np.asarray(heuristic, dtype=float).ravel()
+        weights = np.maximum(weights + estimate[targets] - estimate[sources], 0.0)
+    enterable = np.isfinite(flat)
+    weights[~(enterable[sides[0]] & enterable[sides[1]])] = np.inf
+    graph = csr_matrix((weights, targets, indptr), shape=(flat.size, flat.size))
+    graph.has_sorted_indices = True
+    return graph
+
+
+def shortest_paths(graph, shape, sources, limit=np.inf):
+    """(distances, predecessors), each of `shape` (H, W), of the cheapest paths over
+    `graph` from the nearest of `sources` (flat indices) to every cell whose
+    distance is within `limit`: inf and UNREACHED elsewhere. A source's own
+    step cost never counts."""
+    sources = np.atleast_1d(np.asarray(sources, dtype=np.intp))
+    distances, predecessors, _ = dijkstra(graph, indices=sources, min_only=True, return_predecessors=True,
+                                          limit=limit)
+    return distances.reshape(shape), predecessors.reshape(shape)
+
+
+def path_to(predecessors, target):
+    """The flat indices of the cells from a source to `target` (both included),
+    following `predecessors`; [target] alone if target is a source."""
+    flat = predecessors.ravel()
+    cells = [int(target)]
+    while flat[cells[-1]] != UNREACHED:
+        cells.append(int(flat[cells[-1]]))
+        if len(cells) > flat.size:
+            raise RuntimeError('the predecessors loop: no path to cell %d' % target)
+    return cells[::-1]

@@ -1,0 +1,165 @@
+"""The global planner: navfn's plan on a costmap, as move_base runs it for TurtleBot3. No ROS here.
+
+TurtleBot3's move_base keeps the default global planner, navfn/NavfnROS,
+with its defaults (allow_unknown true, default_tolerance 0). navfn turns
+each cost c of the costmap into a step cost neutral_cost + cost_factor * c
+(50 + 0.8 c: 50 in the open, 246 next to a wall), blocks lethal and
+inscribed cells (>= 253) and lets unknown ones (255) cost 253 when
+allow_unknown; spreads a potential from the robot's cell (whose own cost
+never counts: navfn clears it, the robot stands there); and walks down the
+potential from the goal. Here the potential is an exact shortest-path cost
+over the 8 neighbours of each cell (no diagonal step between two blocked
+cells), found by scipy's Dijkstra at C speed (tb3_navigation.grid_graph),
+and the walk follows its predecessors, so each step of the plan goes to
+the neighbour the cheapest path came from. Orientations are those of global_planner's orientation
+filter (forward): each pose faces the next, the last one is the goal's.
+
+make_plan's tolerance is navfn's: when it is > 0, the plan goes to the
+reachable point nearest to the goal within the square goal +- tolerance,
+sampled at the costmap's resolution.
+"""
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tb3_navigation.costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION
+from tb3_navigation.grid_graph import UNREACHED, build, path_to, shortest_paths
+
+COST_OBS = 254  # navfn: the step cost of a cell it must not enter (and one below: the dearest it may)
+
+
+@dataclass(frozen=True)
+class PlannerConfig:
+    """navfn's parameters (neutral_cost and cost_factor are global_planner's names for
+    navfn's fixed COST_NEUTRAL 50 and COST_FACTOR 0.8)."""
+    allow_unknown: bool = True
+    default_tolerance: float = 0.0
+    neutral_cost: float = 50.0
+    cost_factor: float = 0.8
+
+    def __post_init__(self):
+        for name in ('default_tolerance', 'cost_factor'):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise ValueError('%s must be a finite number >= 0, not %r' % (name, value))
+        if not (isinstance(self.neutral_cost, (int, float)) and 1 <= self.neutral_cost < COST_OBS):
+            raise ValueError('neutral_cost must be within 1..253, not %r' % (self.neutral_cost,))
+
+
+class GlobalPlanner(object):
+    """Plans on a tb3_navigation.costmap.Costmap (or anything with `grid` and `costs`)."""
+
+    def __init__(self, config=PlannerConfig()):
+        self.config = config
+        self.potential = None  # (H, W): the last search's cost from the robot to each cell it reached, else inf
+        self._costs = self._steps = None
+        self._graphs = {}  # of the costs: None: plain; a goal's cell: reweighted toward it (A*)
+
+    def step_costs(self, costs):
+        """navfn's setCostmap: the cost (float (H, W)) of stepping into each cell, inf if it is blocked."""
+        config = self.config
+        costs = np.asarray(costs)
+        steps = np.minimum(config.neutral_cost + config.cost_factor * costs.astype(float), COST_OBS - 1)
+        blocked = costs >= INSCRIBED_INFLATED_OBSTACLE
+        if config.allow_unknown:
+            steps = np.where(costs == NO_INFORMATION, COST_OBS - 1, steps)
+            blocked &= costs != NO_INFORMATION
+        return np.where(blocked, np.inf, steps)
+
+    def make_plan(self, costmap, start, goal, tolerance=None):
+        """The plan [(x, y, yaw), ...] from `start` to `goal` (x, y, yaw, in the
+        costmap's frame), or None: start off the map, goal off the map (with no
+        tolerance), or nothing reachable within `tolerance` (default_tolerance if None)."""
+        tolerance = self.config.default_tolerance if tolerance is None else float(tolerance)
+        if not (np.all(np.isfinite(np.asarray(start, dtype=float)[:2])) and
+                np.all(np.isfinite(np.asarray(goal, dtype=float)[:3])) and math.isfinite(tolerance)):
+            return None
+        grid = costmap.grid
+        start_cell = grid.to_cells(np.asarray(start[:2], dtype=float))
+        if not grid.inside(start_cell):
+            return None
+        self._use(costmap.costs)
+        distances, predecessors = self._search(grid, int(start_cell[1] * grid.width + start_cell[0]), goal, tolerance)
+        self.potential = distances
+        target = self._target(grid, distances, goal, tolerance)
+        if target is None:
+            return None
+        end, index = target
+        cells = np.array(path_to(predecessors, index)[1:-1], dtype=int)
+        middle = grid.centres(np.stack((cells % grid.width, cells // grid.width), axis=-1)).reshape(-1, 2)
+        return orient([tuple(start[:2])] + [tuple(point) for point in middle] + [end], goal[2])
+
+    def _use(self, costs):
+        """Step costs and graph of `costs`, kept while they stay the same (most updates of a
+        global costmap change nothing: the same walls seen again)."""
+        if self._costs is None or self._costs.shape != costs.shape or not np.array_equal(self._costs, costs):
+            self._costs = np.array(costs, copy=True)
+            self._steps = self.step_costs(costs)
+            self._graphs = {}
+
+    def _search(self, grid, start_index, goal, tolerance):
+        """(potential, predecessors) from the robot's cell: everywhere when a tolerance asks
+        for the nearest reachable point; else an A* toward the goal's cell, bounded at
+        twice, then four times, the heuristic's estimate plus 1 m of open travel, then
+        unbounded. Either gives the same plan; the A* visits a fraction of the map (for
+        the plan across turtlebot3_house's 400 x 260 cells, a third of them)."""
+        goal_cell = grid.to_cells(np.asarray(goal[:2], dtype=float))
+        if tolerance > 0 or not grid.inside(goal_cell):
+            if None not in self._graphs:
+                self._graphs[None] = build(self._steps)
+            return shortest_paths(self._graphs[None], grid.shape, [start_index])
+        goal_index = int(goal_cell[1] * grid.width + goal_cell[0])
+        if not np.isfinite(self._steps.ravel()[goal_index]) and goal_index != start_index:
+            return np.full(grid.shape, np.inf), np.full(grid.shape, UNREACHED)  # a blocked goal
+        # The heuristic: navfn's cheapest step (neutral_cost) times the 8-neighbour distance.
+        iy, ix = np.mgrid[0:grid.height, 0:grid.width]
+        dx, dy = np.abs(ix - goal_cell[0]), np.abs(iy - goal_cell[1])
+        heuristic = self.config.neutral_cost * (np.maximum(dx, dy) + (math.sqrt(2) - 1) * np.minimum(dx, dy))
+        if goal_index not in self._graphs:
+            self._graphs = {key: graph for key, graph in self._graphs.items() if key is None}  # one goal kept
+            self._graphs[goal_index] = build(self._steps, heuristic=heuristic)
+        ahead = heuristic.ravel()[start_index]
+        estimate = ahead + self.config.neutral_cost / grid.resolution
+        for bound in (2.0 * estimate, 4.0 * estimate, np.inf):
+            distances, predecessors = shortest_paths(self._graphs[goal_index], grid.shape, [start_index],
+                                                     limit=bound - ahead)
+            if np.isfinite(distances.ravel()[goal_index]):
+                break
+        return distances + ahead - heuristic, predecessors
+
+    @staticmethod
+    def _target(grid, distances, goal, tolerance):
+        """((x, y), flat index) of the point the plan ends at: the goal if reachable, else
+        the reachable sample nearest to it within +- tolerance (navfn's search); None."""
+        offsets = np.arange(-int(math.floor(tolerance / grid.resolution + 1e-9)),
+                            int(math.floor(tolerance / grid.resolution + 1e-9)) + 1) * grid.resolution
+        dx, dy = np.meshgrid(offsets, offsets)
+        points = np.stack((goal[0] + dx.ravel(), goal[1] + dy.ravel()), axis=-1)
+        cells = grid.to_cells(points)
+        inside = grid.inside(cells)
+        points, cells = points[inside], cells[inside]
+        if not len(points):
+            return None
+        reachable = np.isfinite(distances[cells[:, 1], cells[:, 0]])
+        if not reachable.any():
+            return None
+        squared = np.where(reachable, np.sum((points - goal[:2]) ** 2, axis=1), np.inf)
+        best = int(np.argmin(squared))
+        return tuple(points[best]), int(cells[best, 1] * grid.width + cells[best, 0])
+
+
+def orient(points, goal_yaw):
+    """Poses [(x, y, yaw)] of points [(x, y)]: each faces the next, the last has `goal_yaw`."""
+    points = np.asarray(points, dtype=float)
+    yaws = np.full(len(points), float(goal_yaw))
+    if len(points) > 1:
+        steps = np.diff(points, axis=0)
+        yaws[:-1] = np.arctan2(steps[:, 1], steps[:, 0])
+    return [(float(x), float(y), float(yaw)) for (x, y), yaw in zip(points, yaws)]
+
+
+def plan_length(plan):
+    """Length (m) of a plan's polyline."""
+    points = np.asarray(plan, dtype=float)[:, :2]
+    return float(np.sum(np.hypot(*np.diff(points, axis=0).T))) if len(points) > 1 else 0.0
