@@ -1,0 +1,132 @@
+"""The navigation chapter as a learner runs it, judged against the truth (issue 20).
+
+`roslaunch tb3_sim_bringup tb3_world.launch profile:=realistic` (odometry
+drifts), `roslaunch tb3_sim_bringup tb3_navigation.launch open_rviz:=false`
+(the shipped map of turtlebot3_world, amcl starting at its default 0, 0, 0,
+two metres from the robot), then what rviz's tools send: a 2D Pose Estimate
+at the spawn pose, and goals through the move_base action. As fast as
+possible: lockstep makes that the same as real time.
+
+Each goal around and between the pillars must SUCCEED with the true pose
+within TurtleBot3's tolerances, the footprint never nearer than 0.09 m to a
+pillar or wall; a goal inside a pillar is ABORTED; a cancel PREEMPTS and the
+robot stands still within 2 s; a box spawned on the way is driven around.
+"""
+import math
+import os
+
+import pytest
+import rospkg
+
+from tb3_harness.navigating import Navigation, clearance
+from tb3_harness.processes import Process, start_master, wait_until
+
+SPAWN = (-2.0, -0.5, 0.0)  # tb3_world.launch's
+#: Around and between the pillars (0.15 m radius, 1.1 m apart).
+GOALS = [(-0.55, -0.55, 0.0), (0.55, 0.55, math.pi / 2), (1.65, -0.55, -math.pi / 2), (-0.55, 1.65, math.pi)]
+XY_TOLERANCE, YAW_TOLERANCE = 0.05, 0.17  # DWAPlannerROS's, TurtleBot3's
+CLEARANCE = 0.09          # m: the footprint never nearer to a pillar or wall
+BURGER_FOOTPRINT = [(-0.105, -0.105), (-0.105, 0.105), (0.041, 0.105), (0.041, -0.105)]
+STILL_WITHIN = 2.0        # s of sim time after a cancel
+BOX = (0.0, -1.65)        # on the way between the south pillars' row and the wall
+BOX_SDF = """<?xml version="1.0"?>
+<sdf version="1.6"><model name="box_in_the_way"><static>true</static><link name="link">
+<collision name="c"><geometry><box><size>0.3 0.3 0.4</size></box></geometry></collision>
+<visual name="v"><geometry><box><size>0.3 0.3 0.4</size></box></geometry></visual>
+</link></model></sdf>"""
+
+
+@pytest.fixture(scope='module')
+def navigation(tmp_path_factory):
+    """The world, the navigation launch and this process's Navigation, for every test of the file."""
+    import rospy
+    folder = str(tmp_path_factory.mktemp('navigation'))
+    master = start_master(folder)
+    started = []
+    try:
+        os.environ['TURTLEBOT3_MODEL'] = 'burger'
+        started.append(Process('sim', ['roslaunch', 'tb3_sim_bringup', 'tb3_world.launch', 'profile:=realistic',
+                                       'real_time_factor:=0'], folder))
+        started.append(Process('nav', ['roslaunch', 'tb3_sim_bringup', 'tb3_navigation.launch', 'open_rviz:=false'],
+                               folder))
+        rospy.init_node('navigation_test', anonymous=True, disable_signals=True)
+        nav = Navigation()
+        nav.wait_ready()
+        wait_until(lambda: 'map of' in started[1].output(20000), 60.0, 'the map in amcl and move_base',
+                   watch=started)
+        nav.set_pose(*SPAWN)
+        nav.logs = started
+        yield nav
+        nav.close()
+        rospy.signal_shutdown('navigation tests done')
+    finally:
+        for process in reversed(started):
+            process.stop()
+        master.stop()
+
+
+def world_obstacles():
+    from tb3_sim_nav.world_file import load_world
+    return load_world('turtlebot3_world', os.path.join(rospkg.RosPack().get_path('tb3_sim_nav'), 'worlds')).obstacles
+
+
+def test_four_goals_around_the_pillars_succeed_within_the_tolerances(navigation):
+    obstacles = world_obstacles()
+    for goal in GOALS:
+        outcome = navigation.go(*goal)
+        least = clearance(outcome.path, obstacles, BURGER_FOOTPRINT)
+        print('MEASURED goal (%.2f, %.2f, %.2f): %s in %.1f s of sim time; truly %.3f m and %.3f rad off; '
+              'footprint at least %.3f m from the world' % (goal + (outcome.state, outcome.sim_seconds,
+                                                                   outcome.xy_error, outcome.yaw_error, least)))
+        assert outcome.state == 'SUCCEEDED', (goal, outcome.state, outcome.text)
+        assert outcome.xy_error <= XY_TOLERANCE and outcome.yaw_error <= YAW_TOLERANCE, outcome
+        assert least >= CLEARANCE, (goal, least)
+
+
+def test_a_goal_inside_a_pillar_is_aborted(navigation):
+    outcome = navigation.go(0.0, 0.0, 0.0, timeout=300.0)
+    print('MEASURED goal inside the pillar at (0, 0): %s after %.1f s of sim time: %s'
+          % (outcome.state, outcome.sim_seconds, outcome.text))
+    assert outcome.state == 'ABORTED', (outcome.state, outcome.text)
+    assert 'plan' in outcome.text
+
+
+def test_a_cancel_preempts_and_the_robot_stands_still_within_2_s(navigation):
+    import rospy
+    outcome = navigation.go(-1.65, 1.65, 0.0, cancel_after=3.0)
+    cancelled = rospy.get_time()
+    assert outcome.state == 'PREEMPTED', (outcome.state, outcome.text)
+    rospy.sleep(STILL_WITHIN)
+    a = navigation.now_truth()
+    rospy.sleep(1.0)
+    b = navigation.now_truth()
+    moved = math.hypot(b[1] - a[1], b[2] - a[2])
+    print('MEASURED cancel after 3 s: %s; between %.1f and %.1f s after it the robot moved %.4f m'
+          % (outcome.state, a[0] - cancelled, b[0] - cancelled, moved))
+    assert moved < 0.005 and abs(b[3] - a[3]) < 0.01
+
+
+def test_a_box_spawned_on_the_way_is_driven_around(navigation):
+    import rospy
+    from gazebo_msgs.srv import SpawnModel
+    from geometry_msgs.msg import Pose
+    start = navigation.go(-1.65, -1.65, 0.0)
+    assert start.state == 'SUCCEEDED', start
+    pose = Pose()
+    pose.position.x, pose.position.y, pose.position.z = BOX[0], BOX[1], 0.2
+    pose.orientation.w = 1.0
+    spawned = rospy.ServiceProxy('/gazebo/spawn_sdf_model', SpawnModel)(
+        model_name='box_in_the_way', model_xml=BOX_SDF, robot_namespace='', initial_pose=pose, reference_frame='world')
+    assert spawned.success, spawned.status_message
+    outcome = navigation.go(1.65, -1.65, 0.0)
+    obstacles = world_obstacles() + [box_obstacle()]
+    least = clearance(outcome.path, obstacles, BURGER_FOOTPRINT)
+    print('MEASURED past the box: %s in %.1f s of sim time, %.3f m off; footprint at least %.3f m from the world '
+          'and the box' % (outcome.state, outcome.sim_seconds, outcome.xy_error, least))
+    assert outcome.state == 'SUCCEEDED', outcome.text
+    assert least >= CLEARANCE
+
+
+def box_obstacle():
+    from tb3_sim_nav.world_file import Obstacle
+    return Obstacle('box', (0.3, 0.3, 0.4), (BOX[0], BOX[1], 0.2), 0.0, (1, 0, 0, 1), 'box_in_the_way')
