@@ -265,8 +265,18 @@ def test_defaults_are_turtlebot3s_and_bad_values_are_named():
                         ('iterations', 2.5), ('sigma', math.nan), ('lskip', -1), ('maxRange', 2.0)):
         with pytest.raises(SlamConfigError, match=r'parameter %s = %r' % (name, value)):
             SlamConfig(**{name: value})
+    with pytest.raises(SlamConfigError, match="parameter maxUrange = 'far': must be a number"):
+        SlamConfig(maxUrange='far')
     with pytest.raises(dataclasses.FrozenInstanceError):
         config.delta = 0.1
+
+
+def test_a_config_resolves_from_a_lookup_as_a_node_reads_its_parameters():
+    given = {'maxUrange': 4, 'iterations': 8.0, 'particles': 30}  # ints and floats as a launch file gives them
+    config = SlamConfig.resolve(lambda name, default: given.get(name, default))
+    assert config.maxUrange == 4.0 and isinstance(config.maxUrange, float)
+    assert config.iterations == 8 and isinstance(config.iterations, int)
+    assert config.delta == 0.05
 
 
 @pytest.fixture(scope='module')
