@@ -38,7 +38,8 @@ from .pose2d import normalize_angle
 #: Half the side, in cells, of the square of occupied cells whose mean points give a wall's direction.
 SHAPE_RADIUS = 2
 #: A cell's neighbourhood is taken as a line when its spread across is below this share of its spread along
-#: (a straight wall: about 0.01; a corner or a pillar's few cells: above 0.1).
+#: (turtlebot3_world's map: the walls' cells median 0.009, 95 % below 0.05; its pillars' of radius
+#: 0.15 m median 0.08, 14 % below 0.05).
 LINE_SPREAD = 0.05
 #: A cell whose neighbourhood is no line (a corner, clutter) pairs as a point, at this weight of a line's:
 #: its mean point mixes hits on two faces and lies up to half a cell off either. Along a corridor, where

@@ -5,8 +5,9 @@ a beam in it (`hits`); its occupancy is hits / visits, unknown while it was
 never seen. Counts rather than log-odds, because gmapping's map rule is
 stated on them: a cell is occupied when more than `occ_thresh` (0.25 on
 TurtleBot3) of the scans that saw it ended a beam there, so a wall cell
-that one scan in four hits stays a wall. Log-odds would need a prior, a hit
-and a miss weight and clamps to mean the same, and would still not say 0.25.
+that one scan in three hits (and the others see through, grazing it) stays
+a wall; one in four does not. Log-odds would need a prior, a hit and a miss
+weight and clamps to mean the same, and would still not say 0.25.
 
 Counting differs from gmapping in one place, on purpose: gmapping counts a
 visit per beam, so a cell near the sensor that 30 beams of one scan cross
