@@ -5,7 +5,7 @@ tests' drives of the simulated Burger (realistic profile), feeds them to
 Slam, and prints per drive the CPU time of Slam.update per scan
 (time.process_time: median, 95th percentile, mean, max), the pose's error
 against the truth (at the end and the worst along the drive), the
-odometry's, and the map's measures (test/unit/map_measures.py).
+odometry's, and the map's measures (tb3_harness.map_quality).
 
     python3 tools/bench_slam.py [--drives loop,tour,house]
 """
@@ -22,13 +22,12 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'test', 'unit'))
 
-import map_measures  # noqa: E402
 from drives import (HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, path_length,  # noqa: E402
                     record_drive)
+from tb3_harness.map_quality import measure as map_quality  # noqa: E402
 from tb3_navigation.pose2d import normalize_angle  # noqa: E402
 from tb3_navigation.scan import Scan  # noqa: E402
 from tb3_navigation.slam import Slam  # noqa: E402
-from tb3_sim_nav import world_map  # noqa: E402
 from tb3_sim_nav.world_file import load_world  # noqa: E402
 
 #: The whole of turtlebot3_house's rooms from tb3_house.launch's spawn pose and back: 75 m.
@@ -61,23 +60,23 @@ def measure(name):
     poses, cpu = np.array(poses), np.array(cpu) * 1000.0
     distance, turn = errors(poses, drive.truth)
     odom_distance, odom_turn = errors(drive.odom, drive.truth)
-    obstacles = world_map.in_plane(load_world(world, os.path.join(ROOT, 'worlds')).obstacles)
-    values = slam.map_values()
-    points, normals = map_measures.visible_outline(obstacles, drive, slam.config.maxUrange)
+    quality = map_quality(slam.grid, slam.map_values(), load_world(world, os.path.join(ROOT, 'worlds')).obstacles,
+                          start[:2])
     return dict(drive=name, scans=len(cpu), metres=path_length(drive.truth),
                 cpu_median=np.median(cpu), cpu_p95=np.percentile(cpu, 95), cpu_mean=cpu.mean(), cpu_max=cpu.max(),
                 end_cm=100 * distance[-1], end_deg=turn[-1], worst_cm=100 * distance.max(), worst_deg=turn.max(),
                 odom_end_cm=100 * odom_distance[-1], odom_end_deg=odom_turn[-1],
-                precision=100 * map_measures.precision(values, slam.grid, obstacles),
-                coverage=100 * map_measures.coverage(values, slam.grid, points),
-                ghosts=map_measures.ghosts(values, slam.grid, obstacles, points, normals))
+                near=100 * quality.occupied_near_surface, covered=100 * quality.surface_covered,
+                thickness=quality.wall_thickness, thicker=100 * quality.thick_wall_share,
+                doubled=100 * quality.doubled_wall_share)
 
 
 #: (key, width, format) of each column.
 COLUMNS = [('drive', 6, '%s'), ('scans', 6, '%d'), ('metres', 7, '%.1f'), ('cpu_median', 11, '%.1f'),
            ('cpu_p95', 8, '%.1f'), ('cpu_mean', 9, '%.1f'), ('cpu_max', 8, '%.1f'), ('end_cm', 7, '%.1f'),
            ('end_deg', 8, '%.2f'), ('worst_cm', 9, '%.1f'), ('worst_deg', 10, '%.2f'), ('odom_end_cm', 12, '%.1f'),
-           ('odom_end_deg', 13, '%.2f'), ('precision', 10, '%.1f'), ('coverage', 9, '%.1f'), ('ghosts', 7, '%d')]
+           ('odom_end_deg', 13, '%.2f'), ('near', 6, '%.1f'), ('covered', 8, '%.1f'), ('thickness', 10, '%.1f'),
+           ('thicker', 8, '%.1f'), ('doubled', 8, '%.1f')]
 
 
 def main():
@@ -87,9 +86,9 @@ def main():
     print('# SLAM core, %s, %s, %s, %d CPUs, load %.2f' % (
         datetime.date.today(), platform.node(), platform.processor() or platform.machine(), os.cpu_count(),
         os.getloadavg()[0]))
-    print('# cpu: ms of process time per Slam.update; cm/deg: pose against the truth; precision: % of occupied '
-          'cells within 0.10 m of a wall; coverage: % of the walls seen with an occupied cell within 0.10 m; '
-          'ghosts: seen wall points with an occupied cell 0.1-0.3 m in front, where the world is free')
+    print('# cpu: ms of process time per Slam.update; cm/deg: pose against the truth; map (tb3_harness.map_quality, '
+          '%): occupied cells near a surface, surface covered (of the whole world), wall thickness (median cells), '
+          'walls thicker than 2 cells, doubled')
     print(' '.join(key.rjust(width) for key, width, _ in COLUMNS))
     for name in args.drives.split(','):
         row = measure(name.strip())

@@ -49,7 +49,7 @@ def field_of(obstacles, poses, rng):
     for pose in poses:
         sensor = tuple(compose(pose, SENSOR))
         grid_map.add_scan(sensor, ray_cast(obstacles, sensor, rng), MAX_URANGE, RANGE_MAX)
-    return matcher.LikelihoodField(grid_map.grid, grid_map.occupied(), SIGMA, grid_map.hit_means())
+    return matcher.WallField(grid_map.grid, grid_map.occupied(), SIGMA, grid_map.hit_means())
 
 
 def points_at(obstacles, pose, rng):
@@ -118,7 +118,7 @@ def test_along_a_corridor_the_prior_holds_the_pose():
 
 def test_an_empty_map_leaves_the_prior_alone():
     empty = OccupancyGrid.around(0.05, -3.0, -3.0, 3.0, 3.0)
-    field = matcher.LikelihoodField(empty.grid, empty.occupied(), SIGMA, empty.hit_means())
+    field = matcher.WallField(empty.grid, empty.occupied(), SIGMA, empty.hit_means())
     points = points_at(ROOM, (0.0, 0.0, 0.0), np.random.default_rng(8))
     prior = (0.1, 0.2, 0.3)
     assert field.empty

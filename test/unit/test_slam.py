@@ -11,10 +11,9 @@ import pytest
 from tb3_navigation.pose2d import IDENTITY, compose, normalize_angle, relative
 from tb3_navigation.scan import Scan
 from tb3_navigation.slam import Slam, SlamConfig, SlamConfigError
-from tb3_sim_nav import world_map
+from tb3_harness.map_quality import measure
 from tb3_sim_nav.world_file import load_world
 
-import map_measures
 from conftest import REPO
 from drives import HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, path_length, record_drive
 
@@ -49,7 +48,12 @@ def errors(poses, truth):
 
 
 def obstacles(world):
-    return world_map.in_plane(load_world(world, str(REPO / 'worlds')).obstacles)
+    return load_world(world, str(REPO / 'worlds')).obstacles
+
+
+def quality(slam, world, start):
+    """tb3_harness.map_quality's measures of the SLAM's map in `world`'s obstacles, from `start` (x, y)."""
+    return measure(slam.grid, slam.map_values(), world, start[:2])
 
 
 @pytest.fixture(scope='module')
@@ -98,48 +102,26 @@ def test_map_to_odom_maps_odometry_onto_the_pose(loop, loop_slam):
     assert compose(slam.map_to_odom, loop.odom[-1]) == pytest.approx(poses[-1], abs=1e-9)
 
 
-def test_the_maps_walls_lie_on_the_worlds_walls(loop_slam, world):
-    """>= 95 % of the occupied cells within 0.10 m of a surface (measured: 100 %, and
-    all within 0.05 m), and no wall drawn twice."""
+def test_the_maps_walls_lie_on_the_worlds_walls_thin_and_single(loop_slam, world):
+    """The issue's goals (tb3_harness.map_quality): >= 95 % of the occupied cells within
+    0.10 m of a surface, >= 80 % of the surface facing the free space with an occupied cell
+    within 0.10 m, walls a median 2 cells thick or less; and, for no doubled or smeared wall,
+    under 0.5 % of the surface doubled and under 5 % thicker than 2 cells. Measured: 100 %,
+    100 %, 1 cell, 0 % doubled, 0.6 % thicker."""
     slam, _, _ = loop_slam
-    values = slam.map_values()
-    assert np.count_nonzero(values == 100) > 500
-    assert map_measures.precision(values, slam.grid, world) >= 0.95
-
-
-def test_the_map_shows_the_walls_the_lidar_saw(loop, loop_slam, world):
-    """>= 80 % of the outline the beams reached (within maxUrange, from the side they
-    face) has an occupied cell within 0.10 m (measured: 100 %)."""
-    slam, _, _ = loop_slam
-    points, _ = map_measures.visible_outline(world, loop, slam.config.maxUrange)
-    assert len(points) > 1000  # the six walls' inner faces and the nine pillars
-    assert map_measures.coverage(slam.map_values(), slam.grid, points) >= 0.80
-
-
-def test_walls_are_one_or_two_cells_thick_and_not_doubled(loop, loop_slam, world):
-    """Along each seen wall's normal, from 0.1 m inside to 0.1 m out: mostly 2 cells (the
-    surface's cell and, for a surface near a cell's edge, its neighbour), 3 where the
-    normal cuts the corner of a slanted wall's staircase (measured: 1 or 2 for 82 %, 3 or
-    fewer for 99 %); and no occupied cell 0.1 to 0.3 m in front of a wall, where the world
-    is free."""
-    slam, _, _ = loop_slam
-    values = slam.map_values()
-    points, normals = map_measures.visible_outline(world, loop, slam.config.maxUrange)
-    thickness = map_measures.thickness(values, slam.grid, points, normals)
-    assert np.median(thickness) <= 2
-    assert np.mean(thickness <= 3) >= 0.95
-    assert map_measures.ghosts(values, slam.grid, world, points, normals) == 0
+    measured = quality(slam, world, WORLD_LOOP_START)
+    assert not measured.failures(), measured.summary()
+    assert measured.occupied_cells > 500 and measured.surface_points > 1000
+    assert measured.doubled_wall_share < 0.005 and measured.thick_wall_share < 0.05, measured.summary()
 
 
 def test_the_measures_see_what_odometry_alone_draws(loop, world):
-    """The measures above can fail: the map drawn at the odometry's poses (matches never
-    accepted) doubles walls and blurs them (measured: 204 ghost points, 3 cells or fewer
-    for 90 %)."""
+    """The bounds above can fail: the map drawn at the odometry's poses (matches never
+    accepted) meets the issue's goals (96 % near a surface) but doubles 1.5 % of the
+    surface and makes 14 % of it thicker than 2 cells."""
     slam, _, _ = run(loop, slam=Slam(SlamConfig(minimumScore=1e9)))
-    values = slam.map_values()
-    points, normals = map_measures.visible_outline(world, loop, slam.config.maxUrange)
-    assert map_measures.ghosts(values, slam.grid, world, points, normals) > 50
-    assert np.mean(map_measures.thickness(values, slam.grid, points, normals) <= 3) < 0.95
+    measured = quality(slam, world, WORLD_LOOP_START)
+    assert measured.doubled_wall_share > 0.005 and measured.thick_wall_share > 0.05, measured.summary()
 
 
 def test_the_same_input_gives_the_same_map(loop, loop_slam):
@@ -159,7 +141,7 @@ def test_nan_and_infinite_beams_are_skipped_one_by_one(loop, world):
     slam, poses, _ = run(loop, ranges=ranges)
     distance, turn = errors(poses, loop.truth)
     assert distance.max() < 0.05 and turn.max() < math.radians(2.0)
-    assert map_measures.precision(slam.map_values(), slam.grid, world) >= 0.95
+    assert quality(slam, world, WORLD_LOOP_START).occupied_near_surface >= 0.95
 
 
 def test_a_scan_with_too_few_valid_beams_does_not_move_the_pose(loop):
@@ -199,7 +181,7 @@ def test_an_odometry_reset_in_place_does_not_move_the_pose(loop, world):
     assert np.flatnonzero(jumps).tolist() == [200]
     distance, turn = errors(poses, loop.truth)
     assert distance.max() < 0.05 and turn.max() < math.radians(2.0)
-    assert map_measures.precision(slam.map_values(), slam.grid, world) >= 0.95
+    assert quality(slam, world, WORLD_LOOP_START).occupied_near_surface >= 0.95
 
 
 def test_bad_odometry_and_a_blind_first_scan_change_nothing(loop):
@@ -290,16 +272,13 @@ def test_a_tour_of_the_house_drifts_too_little_to_double_walls(tour):
     again from a pose off by more than the matcher's reach (0.15 m) would be drawn anew
     beside the old one. Measured: at most 2.4 cm (gained in the corridor, which tells
     little along itself, and kept from there on: the map has no loop to close) and 0.85
-    degree (turning); odometry ends 25 cm and 2 degrees off. And the map: no wall drawn
-    twice, >= 95 % of its walls on the world's (measured 100 %), >= 80 % of what the
-    lidar saw shown (measured 100 %)."""
-    house = obstacles('turtlebot3_house')
+    degree (turning); odometry ends 25 cm and 2 degrees off. And the map, with the loop's
+    bounds: 100 % of its occupied cells near a surface, walls 1 cell, 0 % doubled, 0.3 %
+    thicker than 2 cells (the issue's coverage is for a whole house: this tour sees 41 %)."""
     slam, poses, jumps = run(tour)
     assert path_length(tour.truth) > 30.0 and not jumps.any()
     distance, turn = errors(poses, tour.truth)
     assert distance.max() < 0.10 and turn.max() < math.radians(2.0)
-    values = slam.map_values()
-    points, normals = map_measures.visible_outline(house, tour, slam.config.maxUrange)
-    assert map_measures.ghosts(values, slam.grid, house, points, normals) == 0
-    assert map_measures.precision(values, slam.grid, house) >= 0.95
-    assert map_measures.coverage(values, slam.grid, points) >= 0.80
+    measured = quality(slam, obstacles('turtlebot3_house'), HOUSE_TOUR_START)
+    assert measured.occupied_near_surface >= 0.95 and measured.wall_thickness <= 2, measured.summary()
+    assert measured.doubled_wall_share < 0.005 and measured.thick_wall_share < 0.05, measured.summary()

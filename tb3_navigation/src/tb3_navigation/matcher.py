@@ -49,14 +49,18 @@ LINE_SPREAD = 0.05
 CORNER_WEIGHT = 0.3
 
 
-class LikelihoodField(object):
-    """The likelihood field of `occupied` (bool, the grid's shape) on `grid`, for matching with `sigma` (m),
-    and the walls to pair points with: each occupied cell's point `means` (height, width, 2) in the
-    frame (NaN, or None for all: the cell's centre) and the wall's direction there.
+class WallField(object):
+    """The map as the matcher reads it: the likelihood field of `occupied` (bool, the grid's shape) on
+    `grid` for `sigma` (m), and the walls to pair points with: each occupied cell's point `means`
+    (height, width, 2) in the frame (NaN, or None for all: the cell's centre) and the wall's
+    direction there.
 
-    Both are only computed over the box around the occupied cells widened by
-    4 sigma (and one more cell): farther out the field is below exp(-8) and
-    taken as 0, which a ring of zeros around the box gives.
+    Unlike amcl's field (tb3_navigation.likelihood: made once per map, over
+    the whole grid), this one is made anew as the map grows, a few times a
+    second: so it is only computed over the box around the occupied cells
+    widened by 4 sigma (and one more cell), where the field is below exp(-8)
+    and taken as 0, which a ring of zeros around the box gives; and it keeps
+    each cell's nearest occupied cell, to pair points with.
     """
 
     def __init__(self, grid, occupied, sigma, means=None):

@@ -223,7 +223,7 @@ class Slam(object):
         if self._field is None or self._field_version != self.map_updates:
             occupied = self.map.occupied(self.config.occ_thresh)
             if self._field is None or not np.array_equal(occupied, self._field_of):
-                self._field = matcher.LikelihoodField(self.map.grid, occupied, self.config.sigma,
+                self._field = matcher.WallField(self.map.grid, occupied, self.config.sigma,
                                                       self.map.hit_means())
                 self._field_of = occupied
             self._field_version = self.map_updates
