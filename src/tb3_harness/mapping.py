@@ -69,21 +69,21 @@ def map_world(log_dir, output, factor=0.0, profile='realistic', seed=7, world='t
     rosgraph.Master('/tb3_harness').setParam('/tb3_sim/seed', seed)
     started = []
 
-    def start(name, argv):
+    def spawn(name, argv):
         process = Process(name, argv, log_dir)
         started.append(process)
         return process
     try:
-        sim = start('sim', ['roslaunch', 'tb3_sim_bringup', launch, 'profile:=%s' % profile,
+        sim = spawn('sim', ['roslaunch', 'tb3_sim_bringup', launch, 'profile:=%s' % profile,
                             'real_time_factor:=%g' % factor])
-        slam = start('slam', ['roslaunch', 'tb3_sim_bringup', 'tb3_slam.launch', 'open_rviz:=false'])
+        slam = spawn('slam', ['roslaunch', 'tb3_sim_bringup', 'tb3_slam.launch', 'open_rviz:=false'])
         wait_until(lambda: 'tb3_slam parameters' in slam.output(20000), READY_TIMEOUT, 'SLAM node',
                    watch=(sim, slam))
         slam_pid = _node_pid('/tb3_slam')
         path_file = os.path.join(log_dir, 'route_%g.json' % factor)
         say('mapping at factor %g: driving the %s route' % (factor, route))
         wall_start, cpu_start = time.monotonic(), cpu_seconds(slam_pid)
-        driver = start('driver', ['python3', '-m', 'tb3_harness.route_driver', route, '--out', path_file])
+        driver = spawn('driver', ['python3', '-m', 'tb3_harness.route_driver', route, '--out', path_file])
         wait_until(lambda: not driver.running(), ROUTE_TIMEOUT, 'end of the route', watch=(sim, slam))
         wall = time.monotonic() - wall_start
         slam_cpu = (cpu_seconds(slam_pid) - cpu_start) / wall
@@ -92,7 +92,7 @@ def map_world(log_dir, output, factor=0.0, profile='realistic', seed=7, world='t
         with open(path_file) as stream:
             paths = json.load(stream)
         map_name = os.path.join(output, 'map')
-        saver = start('map_saver', ['rosrun', 'map_server', 'map_saver', '-f', map_name])
+        saver = spawn('map_saver', ['rosrun', 'map_server', 'map_saver', '-f', map_name])
         if saver.wait(SAVE_TIMEOUT) != 0:
             raise RunError('map_saver did not save the map (exit %s): %s' % (saver.popen.returncode, tail(saver.log)))
         say('mapping at factor %g: the route took %.1f s of sim time, %.1f s wall; map saved to %s.yaml'

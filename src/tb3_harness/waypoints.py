@@ -14,6 +14,17 @@ WORLD_LOOP_START = (-2.0, -0.5, 0.0)
 WORLD_LOOP = [(-1.65, -0.5), (-1.65, 1.65), (0.55, 1.65), (1.65, 1.65), (1.65, -0.55), (1.65, -1.65),
               (-0.55, -1.65), (-1.65, -1.65), (-1.65, -0.5), (-2.0, -0.5)]
 
+#: A tour of about 33 m through turtlebot3_house from tb3_house.launch's spawn pose
+#: (-3.0, 1.0): across the living room into the corridor, through the door at
+#: x = 2.3 into the east room, through the door at its north-west corner into
+#: the room behind (x -0.05..2.3) and back, round the marble table, and through
+#: the south door into the south-east room, 14 m of walls away from the start.
+#: Every waypoint and the straight legs between them stay 0.39 m or more from
+#: every obstacle of the lidar's cut.
+HOUSE_TOUR_START = (-3.0, 1.0, 0.0)
+HOUSE_TOUR = [(-1.0, 1.2), (-1.0, 0.4), (1.2, 0.4), (3.0, 0.4), (3.0, 4.6), (1.0, 4.6), (1.0, 1.6), (1.0, 4.6),
+              (3.0, 4.6), (6.5, 4.0), (6.8, 1.0), (6.2, 0.5), (6.2, -1.0), (5.6, -1.5), (5.6, -4.5)]
+
 
 def steer(pose, target, speed=0.18, turn_speed=1.0):
     """(v, w) from `pose` (x, y, yaw) towards `target` (x, y): turn in place when facing

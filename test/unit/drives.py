@@ -18,7 +18,8 @@ from tb3_sim_nav.robot_model import load_model
 from tb3_sim_nav.simulation import build
 from tb3_sim_nav.world_file import load_world
 
-from tb3_harness.waypoints import WORLD_LOOP, WORLD_LOOP_START, Route, path_length  # noqa: F401 (for the tests)
+from tb3_harness.waypoints import (HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, Route,  # noqa: F401
+                                   path_length)  # (for the tests)
 
 from conftest import REPO
 

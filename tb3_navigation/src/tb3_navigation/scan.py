@@ -16,6 +16,7 @@ class Scan(object):
 
     def __init__(self, angle_min, angle_increment, ranges, range_min, range_max):
         ranges = np.asarray(ranges, dtype=float)
+        self.angle_min, self.angle_increment = float(angle_min), float(angle_increment)
         self.angles = angle_min + angle_increment * np.arange(ranges.size)
         self.ranges = ranges
         self.range_min, self.range_max = float(range_min), float(range_max)
@@ -32,6 +33,15 @@ class Scan(object):
 
     def __len__(self):
         return self.ranges.size
+
+    def within(self, max_range):
+        """This scan without its hits longer than `max_range`, and without the beams that saw
+        nothing within the sensor's range when `max_range` is shorter than that range: what
+        gmapping's maxRange drops whole (a shorter maxUrange still clears along them)."""
+        if not max_range < self.range_max:
+            return self
+        ranges = np.where(self.hits & (self.ranges <= max_range), self.ranges, np.nan)
+        return Scan(self.angle_min, self.angle_increment, ranges, self.range_min, self.range_max)
 
     def subsample(self, max_beams):
         """Indices of at most `max_beams` beams spread evenly over the scan (amcl's laser_max_beams)."""
