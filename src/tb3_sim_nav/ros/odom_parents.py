@@ -55,6 +55,7 @@ class OdomParents(object):
         self._needles = dict((frame, needle(frame)) for frame in frames)
         self._lock = threading.Lock()
         self._claims = {}  # odom frame -> (caller id, parent frame, pose of odom in parent)
+        self._own = rospy.get_name()
         # tf_static too: `static_transform_publisher ... map odom` is a parent as well.
         self._subscribers = [rospy.Subscriber(topic, AnyMsg, self._on_tf, queue_size=10, tcp_nodelay=True)
                              for topic in ('tf', 'tf_static')]
@@ -66,9 +67,11 @@ class OdomParents(object):
         self._needles = dict(self._needles, **{frame: needle(frame)})
 
     def _on_tf(self, raw):
+        caller = rospy_internals.caller_id(raw)
+        if caller == self._own:  # connected to ourselves before ignore_own_publications took hold
+            return
         found = parents_in(raw._buff, self._needles)
         if found:
-            caller = rospy_internals.caller_id(raw)
             with self._lock:
                 for child, (parent, pose) in found.items():
                     self._claims[child] = (caller, parent, pose)

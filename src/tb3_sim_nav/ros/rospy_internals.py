@@ -64,6 +64,12 @@ def ignore_own_publications(subscriber):
     impl, own = subscriber.impl, rospy.core.get_node_uri()
     has_connection = impl.has_connection
     impl.has_connection = lambda uri: uri == own or has_connection(uri)
+    # rospy may have connected already, between registering and here: close that
+    # connection (Subscriber.impl.connections, endpoint_id the publisher's URI).
+    for connection in list(impl.connections):
+        if connection.endpoint_id == own:
+            impl.remove_connection(connection)
+            connection.close()
 
 
 def caller_id(message):
