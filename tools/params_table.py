@@ -1,9 +1,23 @@
-"""Prints the README's table of the simulator's parameters, from params.py."""
+"""Prints doc/reference.md's tables of parameters: the simulator's (params.py), or with
+--navigation those of the SLAM, amcl and move_base nodes (their cores' config dataclasses:
+each field's doc, else the comment on its line)."""
+import dataclasses
+import inspect
 import os
+import re
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'src'))
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..')
+sys.path[:0] = [os.path.join(ROOT, 'src'), os.path.join(ROOT, 'tb3_navigation', 'src')]
 from tb3_sim_nav.params import FROM_MODEL, FROM_PROFILE, PARAMETERS, PROFILES  # noqa: E402
+
+#: (node, parameter namespace, config class) of the navigation nodes, in doc/reference.md's order.
+NAVIGATION = [('tb3_slam', '', 'tb3_navigation.slam.SlamConfig'),
+              ('amcl', '', 'tb3_navigation.localization.AmclConfig'),
+              ('move_base', '', 'tb3_navigation.navigator.NavigatorConfig'),
+              ('move_base', 'global_costmap/, local_costmap/', 'tb3_navigation.costmap.CostmapConfig'),
+              ('move_base', 'NavfnROS/', 'tb3_navigation.planner.PlannerConfig'),
+              ('move_base', 'DWAPlannerROS/', 'tb3_navigation.controller.DwaConfig')]
 
 
 def shown(value):
@@ -12,7 +26,37 @@ def shown(value):
     return '`%s`' % value if isinstance(value, str) else repr(value)
 
 
+def _comments(cls):
+    """{field: the comment on its line} of a dataclass's source."""
+    found = {}
+    for line in inspect.getsource(cls).split('\n'):
+        match = re.match(r'\s+(\w+):[^#]*#\s*(.*)$', line)
+        if match:
+            found[match.group(1)] = match.group(2).strip()
+    return found
+
+
+def navigation():
+    import importlib
+    for node, namespace, path in NAVIGATION:
+        module, name = path.rsplit('.', 1)
+        cls = getattr(importlib.import_module(module), name)
+        comments = _comments(cls)
+        print('`%s`%s (`%s`):' % (node, ', under `~%s`' % namespace if namespace else '', name))
+        print('')
+        print('| parameter | default | meaning |')
+        print('|---|---|---|')
+        for field in dataclasses.fields(cls):
+            if dataclasses.is_dataclass(field.type) or field.default is dataclasses.MISSING:
+                continue
+            doc = field.metadata.get('doc') or comments.get(field.name, '')
+            print('| `%s` | %s | %s |' % (field.name, shown(field.default), doc.replace('|', '/')))
+        print('')
+
+
 def main():
+    if sys.argv[1:] == ['--navigation']:
+        return navigation()
     print('| parameter | default | unit | meaning |')
     print('|---|---|---|---|')
     for parameter in PARAMETERS:

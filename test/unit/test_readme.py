@@ -128,6 +128,14 @@ def test_the_reference_parameter_table_is_the_generated_one():
     assert table.strip() in _read('doc/reference.md')
 
 
+def test_the_reference_navigation_parameter_tables_are_the_generated_ones():
+    tables = subprocess.run([sys.executable, os.path.join(ROOT, 'tools', 'params_table.py'), '--navigation'],
+                            stdout=subprocess.PIPE, universal_newlines=True, check=True).stdout
+    reference = _read('doc/reference.md')
+    missing = [table for table in tables.split('\n\n') if table.strip() and table.strip() not in reference]
+    assert not missing, missing
+
+
 @pytest.mark.parametrize('launch', sorted(os.listdir(os.path.join(ROOT, 'launch'))))
 def test_every_launch_argument_is_documented(launch):
     root = ElementTree.parse(os.path.join(ROOT, 'launch', launch)).getroot()

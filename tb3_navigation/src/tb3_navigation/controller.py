@@ -50,38 +50,38 @@ PASSED = 0.6
 class DwaConfig:
     """dwa_local_planner's parameters: dwa_local_planner_params_burger.yaml (noetic), and
     dwa_local_planner's defaults for those it does not set."""
-    max_vel_x: float = 0.22
-    min_vel_x: float = -0.22
-    max_vel_y: float = 0.0
-    min_vel_y: float = 0.0
-    max_vel_trans: float = 0.22
-    min_vel_trans: float = 0.11
-    max_vel_theta: float = 2.75
-    min_vel_theta: float = 1.37
-    acc_lim_x: float = 2.5
-    acc_lim_y: float = 0.0
-    acc_lim_theta: float = 3.2
-    xy_goal_tolerance: float = 0.05
-    yaw_goal_tolerance: float = 0.17
-    latch_xy_goal_tolerance: bool = False
-    sim_time: float = 1.5
-    sim_granularity: float = 0.025
-    angular_sim_granularity: float = 0.1
-    vx_samples: int = 20
-    vy_samples: int = 0
-    vth_samples: int = 40
-    controller_frequency: float = 10.0
-    path_distance_bias: float = 32.0
-    goal_distance_bias: float = 20.0
-    occdist_scale: float = 0.02
-    forward_point_distance: float = 0.325
-    stop_time_buffer: float = 0.2
-    scaling_speed: float = 0.25
-    max_scaling_factor: float = 0.2
-    oscillation_reset_dist: float = 0.05
-    oscillation_reset_angle: float = 0.2
-    trans_stopped_vel: float = 0.1
-    theta_stopped_vel: float = 0.1
+    max_vel_x: float = 0.22  # m/s
+    min_vel_x: float = -0.22  # m/s: negative drives backwards (move_forward_only: 0)
+    max_vel_y: float = 0.0  # a differential base: 0
+    min_vel_y: float = 0.0  # a differential base: 0
+    max_vel_trans: float = 0.22  # m/s
+    min_vel_trans: float = 0.11  # m/s: slower drives must turn at least min_vel_theta
+    max_vel_theta: float = 2.75  # rad/s
+    min_vel_theta: float = 1.37  # rad/s: the slowest turn in place
+    acc_lim_x: float = 2.5  # m/s^2
+    acc_lim_y: float = 0.0  # a differential base: 0
+    acc_lim_theta: float = 3.2  # rad/s^2
+    xy_goal_tolerance: float = 0.05  # m: the goal is reached this near (the controller aims at 0.4 of it)
+    yaw_goal_tolerance: float = 0.17  # rad: and turned this near (aims at 0.4 of it)
+    latch_xy_goal_tolerance: bool = False  # true: once near enough, only turn
+    sim_time: float = 1.5  # s each sampled trajectory is simulated
+    sim_granularity: float = 0.025  # m between checks along a trajectory
+    angular_sim_granularity: float = 0.1  # rad between checks along a turn
+    vx_samples: int = 20  # speeds sampled
+    vy_samples: int = 0  # a differential base: 0
+    vth_samples: int = 40  # turn rates sampled
+    controller_frequency: float = 10.0  # Hz: the window of reachable speeds is one period of the accelerations
+    path_distance_bias: float = 32.0  # weight of staying on the global plan
+    goal_distance_bias: float = 20.0  # weight of getting to the local goal
+    occdist_scale: float = 0.02  # weight of keeping off obstacles
+    forward_point_distance: float = 0.325  # m: the point ahead scored too
+    stop_time_buffer: float = 0.2  # s: a trajectory must stop this long before an obstacle
+    scaling_speed: float = 0.25  # m/s: above it the footprint is scaled up
+    max_scaling_factor: float = 0.2  # up to 1 + this
+    oscillation_reset_dist: float = 0.05  # m: moving this far resets the oscillation flags
+    oscillation_reset_angle: float = 0.2  # rad: turning this far resets them too
+    trans_stopped_vel: float = 0.1  # m/s: slower counts as stopped
+    theta_stopped_vel: float = 0.1  # rad/s: slower counts as stopped
 
     def __post_init__(self):
         for field in fields(self):
@@ -151,11 +151,15 @@ class DwaController(object):
         self._flags = {}
         self._stationary = None
 
+    def _same_goal(self, goal):
+        return getattr(self, '_arrival_goal', None) is not None and \
+            math.hypot(goal[0] - self._arrival_goal[0], goal[1] - self._arrival_goal[1]) <= 1e-6
+
     def _arrive(self, pose, goal):
         """Whether the approach is over (once over, it stays so for this goal, across new plans): within
-        ARRIVAL of xy_goal_tolerance, or within the tolerance and past the closest point of the way in."""
-        if getattr(self, '_arrival_goal', None) is None or np.hypot(*(np.subtract(goal[:2], self._arrival_goal))) > 1e-6:
-            self._arrival_goal, self._arrived, self._closest = tuple(goal[:2]), False, math.inf
+        ARRIVAL of xy_goal_tolerance, or within PASSED of it and past the closest point of the way in."""
+        if not self._same_goal(goal):
+            self._arrival_goal, self._arrived, self._closest = (goal[0], goal[1]), False, math.inf
         distance = math.hypot(goal[0] - pose[0], goal[1] - pose[1])
         tolerance = self.config.xy_goal_tolerance
         if distance <= ARRIVAL * tolerance or (distance <= PASSED * tolerance and distance > self._closest + 1e-3):
@@ -170,8 +174,7 @@ class DwaController(object):
         config = self.config
         goal = plan[-1]
         distance = math.hypot(goal[0] - pose[0], goal[1] - pose[1])
-        arrived = getattr(self, '_arrival_goal', None) is not None and self._arrived and \
-            np.hypot(*(np.subtract(goal[:2], self._arrival_goal))) <= 1e-6
+        arrived = self._same_goal(goal) and self._arrived
         if (config.latch_xy_goal_tolerance and self._latched) or \
                 (distance <= config.xy_goal_tolerance and (arrived or distance <= ARRIVAL * config.xy_goal_tolerance)):
             self._latched = True

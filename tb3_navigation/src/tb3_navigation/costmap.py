@@ -60,16 +60,16 @@ TRANSLATION = np.array([0] + [1 + (97 * (cost - 1)) // 251 for cost in range(1, 
 @dataclass(frozen=True)
 class CostmapConfig:
     """costmap_2d's parameters, TurtleBot3's values (the Burger's footprint)."""
-    footprint: tuple = BURGER_FOOTPRINT
-    footprint_padding: float = 0.01
-    obstacle_range: float = 3.0
-    raytrace_range: float = 3.5
-    inflation_radius: float = 1.0
-    cost_scaling_factor: float = 3.0
-    track_unknown_space: bool = False
-    lethal_cost_threshold: int = 100
-    inf_is_valid: bool = False
-    footprint_clearing_enabled: bool = True
+    footprint: tuple = BURGER_FOOTPRINT  # m: the robot's outline in base_footprint (the Burger's)
+    footprint_padding: float = 0.01  # m added around the footprint
+    obstacle_range: float = 3.0  # m: scan hits nearer than this are marked
+    raytrace_range: float = 3.5  # m: space along a beam is cleared up to this
+    inflation_radius: float = 1.0  # m: costs fall off this far from an obstacle
+    cost_scaling_factor: float = 3.0  # how fast: 252 exp(-factor (d - inscribed radius))
+    track_unknown_space: bool = False  # true: unseen cells stay unknown (plans avoid them unless allow_unknown)
+    lethal_cost_threshold: int = 100  # map cells this or more are obstacles
+    inf_is_valid: bool = False  # true: beams reading inf clear up to raytrace_range
+    footprint_clearing_enabled: bool = True  # the robot's own footprint is cleared of obstacles
 
     def __post_init__(self):
         points = np.asarray(self.footprint, dtype=float)

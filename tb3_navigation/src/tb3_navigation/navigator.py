@@ -54,21 +54,21 @@ class NavigatorConfig:
     """move_base's parameters: TurtleBot3's move_base_params.yaml, move_base's defaults for the rest.
     recovery_behaviors names the behaviours in order (move_base's list gives {name, type}
     each: the node passes the names of the clear_costmap_recovery and rotate_recovery ones)."""
-    global_frame: str = 'map'
-    controller_frequency: float = 10.0
-    planner_frequency: float = 5.0
-    planner_patience: float = 5.0
-    controller_patience: float = 15.0
-    max_planning_retries: int = -1
-    oscillation_timeout: float = 10.0
-    oscillation_distance: float = 0.2
-    conservative_reset_dist: float = 3.0
-    circumscribed_radius: float = 0.46
-    recovery_behavior_enabled: bool = True
-    clearing_rotation_allowed: bool = True
-    recovery_behaviors: tuple = DEFAULT_RECOVERIES
-    quaternion_norm_tolerance: float = 1e-3
-    rotation_timeout: float = 30.0
+    global_frame: str = 'map'  # the global costmap's frame: goals are planned in it
+    controller_frequency: float = 10.0  # Hz: control cycles (sim time)
+    planner_frequency: float = 5.0  # Hz: the global plan is made anew this often while driving; 0: only once per goal
+    planner_patience: float = 5.0  # s without a plan before the recoveries
+    controller_patience: float = 15.0  # s without a valid command before the recoveries
+    max_planning_retries: int = -1  # failed plans before the recoveries; -1: planner_patience alone decides
+    oscillation_timeout: float = 10.0  # s without moving oscillation_distance before the recoveries; 0: never
+    oscillation_distance: float = 0.2  # m: moving this far resets the oscillation timer
+    conservative_reset_dist: float = 3.0  # m: the first recovery forgets obstacles outside this square
+    circumscribed_radius: float = 0.46  # m: the aggressive reset's square is 4 times this
+    recovery_behavior_enabled: bool = True  # false: no recoveries, ABORTED at once
+    clearing_rotation_allowed: bool = True  # false: the recoveries do not turn in place
+    recovery_behaviors: tuple = DEFAULT_RECOVERIES  # move_base's default four, in its order
+    quaternion_norm_tolerance: float = 1e-3  # a goal's quaternion further than this from length 1 is ABORTED
+    rotation_timeout: float = 30.0  # s: a recovery turn gives up after this (ours: a robot that cannot turn)
     rotate_recovery: RotateRecoveryConfig = RotateRecoveryConfig()  # frozen: one shared default is safe
 
     def __post_init__(self):

@@ -33,10 +33,10 @@ COST_OBS = 254  # navfn: the step cost of a cell it must not enter (and one belo
 class PlannerConfig:
     """navfn's parameters (neutral_cost and cost_factor are global_planner's names for
     navfn's fixed COST_NEUTRAL 50 and COST_FACTOR 0.8)."""
-    allow_unknown: bool = True
-    default_tolerance: float = 0.0
-    neutral_cost: float = 50.0
-    cost_factor: float = 0.8
+    allow_unknown: bool = True  # plans may cross unknown cells
+    default_tolerance: float = 0.0  # m: how far from an unreachable goal a plan may end
+    neutral_cost: float = 50.0  # a free cell's step cost (navfn's COST_NEUTRAL)
+    cost_factor: float = 0.8  # each unit of a cell's cost adds this to its step cost (navfn's COST_FACTOR)
 
     def __post_init__(self):
         for name in ('default_tolerance', 'cost_factor'):

@@ -70,9 +70,9 @@ class SlamConfig(object):
     maxRange: float = 0.0  # m: hits longer than this are dropped whole; 0 = the scan's range_max
     delta: float = 0.05  # m: the map's cell
     xmin: float = -10.0  # m: the map's extent in the map frame; its origin is (xmin, ymin)
-    ymin: float = -10.0
-    xmax: float = 10.0
-    ymax: float = 10.0
+    ymin: float = -10.0  # m
+    xmax: float = 10.0  # m
+    ymax: float = 10.0  # m
     linearUpdate: float = 1.0  # m driven before a scan is added to the map
     angularUpdate: float = 0.2  # rad turned before a scan is added to the map
     temporalUpdate: float = 0.5  # s since the last added scan before one is added anyway; < 0: never
