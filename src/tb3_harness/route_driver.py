@@ -64,7 +64,7 @@ def main(argv=None):
         except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException):
             pass
 
-    rate = rospy.Rate(30)
+    period = 1.0 / 30
     while not life.stopping and not ('truth' in latest and 'odom' in latest):
         life.sleep(0.05)
     start = next_record = rospy.get_time()
@@ -76,14 +76,10 @@ def main(argv=None):
         if now >= next_record:
             record(now)
             next_record = now + RECORD_PERIOD
-        try:
-            rate.sleep()
-        except rospy.ROSInterruptException:
-            break
+        life.sleep_sim(max(0.0, now + period - rospy.get_time()))
     cmd_vel.publish(Twist())
     end = rospy.get_time()
-    if not life.stopping:
-        rospy.sleep(1.0)
+    if life.sleep_sim(1.0):
         record(rospy.get_time())
     document = dict(paths, sim_seconds=end - start, finished=route.done)
     text = json.dumps(document)

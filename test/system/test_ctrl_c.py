@@ -150,3 +150,34 @@ def test_every_other_way_to_end_the_simulator_takes_under_2_s(how, ros_port, pro
     launch.stop()
     reader.stop()
     assert not leftovers.check(tag, how)
+
+
+@pytest.mark.parametrize('clock', ['running', 'stopped'])
+@pytest.mark.parametrize('launch', ['tb3_slam.launch', 'tb3_navigation.launch'])
+def test_the_mapping_and_navigation_nodes_end_within_2_s_of_ctrl_c(launch, clock, ros_port, processes):
+    """Every node of the launch gone within 2 s of Ctrl+C, also when the simulator ended first and
+    /clock stands still (a node waiting in sim time must not wait for a clock that never comes)."""
+    processes.start_master('roscore', ros_port)
+    tag = 'nav_%s_%s' % (launch.split('.')[0], clock)
+    world = start_world(processes, 0.0, tag)
+    simulator_of(world)
+    nav = processes.start('nav_' + tag, ['roslaunch', 'tb3_sim_bringup', launch, 'open_rviz:=false'],
+                          env=dict(os.environ, **{leftovers.TAG: tag}))
+    ready = 'tb3_slam parameters' if launch == 'tb3_slam.launch' else 'map of'
+    assert wait_until(lambda: nav.output(20000).count(ready) >= (1 if launch == 'tb3_slam.launch' else 2),
+                      READY_TIMEOUT, poll=0.1), nav.describe()
+    nodes = children(nav.pid)
+    time.sleep(2.0)
+    if clock == 'stopped':
+        os.kill(world.pid, signal.SIGINT)
+        assert world.wait(20.0) is not None, world.describe()
+    os.kill(nav.pid, signal.SIGINT)  # Ctrl+C in the launch's terminal
+    pressed = time.monotonic()
+    gone = wait_until(lambda: not any(alive(pid) for pid in nodes), 20.0, poll=0.02)
+    took = time.monotonic() - pressed
+    print('MEASURED %s, clock %s: its %d nodes gone %.2f s after Ctrl+C' % (launch, clock, len(nodes), took))
+    assert gone and took <= GONE_WITHIN, '%s: %s' % ([command for pid, command in nodes.items() if alive(pid)],
+                                                     nav.describe())
+    world.stop()
+    assert nav.wait(20.0) is not None
+    assert not leftovers.check(tag, '%s with the clock %s' % (launch, clock))

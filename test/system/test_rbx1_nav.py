@@ -11,7 +11,10 @@ setup.bash`:
   1 m square, the robot back at its start.
 - nav_test.py in the world built from the book's test_map, with the same
   map: it waits for a 2D Pose Estimate (sent here as rviz sends it, once it
-  asks), then visits random named rooms; three must succeed in a row.
+  asks), then visits random named rooms, resting 10 s at each; two must
+  succeed in a row.
+
+Both at real time, as the README shows the commands.
 """
 import math
 import os
@@ -26,20 +29,23 @@ from tb3_harness.processes import Process, start_master, tail, wait_until
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BOOK = os.path.join(REPO, 'test', 'data', 'rbx1_nav')
-MAPS = os.path.join(REPO, 'maps', 'rbx1')
 PYTHON3_FIX = ('sequence = sample(locations, n_locations)', 'sequence = sample(list(locations), n_locations)')
 RVIZ_POSE = ("{header: {frame_id: map}, pose: {pose: {orientation: {w: 1.0}}, covariance: [0.25, 0, 0, 0, 0, 0, "
              "0, 0.25, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.06853891945]}}")
 
 
-def start_world(folder, world=None):
-    launch = ['roslaunch', 'tb3_sim_bringup', 'tb3_empty_world.launch', 'real_time_factor:=0']
-    return Process('sim', launch + (['world:=' + world] if world else []), folder)
+# The README's commands, as a learner types them (rviz left out: no screen here).
+SQUARE = ['roslaunch tb3_sim_bringup tb3_empty_world.launch',
+          'roslaunch tb3_sim_bringup tb3_navigation.launch map_file:=`rospack find tb3_sim_nav`/maps/rbx1/blank_map.yaml',
+          './move_base_square.py']
+TOUR = ['roslaunch tb3_sim_bringup tb3_empty_world.launch world:=`rospack find tb3_sim_nav`/maps/rbx1/test_map.yaml',
+        'roslaunch tb3_sim_bringup tb3_navigation.launch map_file:=`rospack find tb3_sim_nav`/maps/rbx1/test_map.yaml',
+        './nav_test.py']
+NO_RVIZ = ' open_rviz:=false'
 
 
-def start_navigation(folder, map_file):
-    return Process('nav', ['roslaunch', 'tb3_sim_bringup', 'tb3_navigation.launch', 'open_rviz:=false',
-                           'map_file:=' + map_file], folder)
+def typed(name, command, folder):
+    return Process(name, ['bash', '-c', command], folder, cwd=folder)
 
 
 def true_pose():
@@ -57,8 +63,8 @@ def test_move_base_square_unchanged_drives_the_square_and_comes_home(tmp_path):
     master = start_master(folder)
     started = []
     try:
-        started += [start_world(folder), start_navigation(folder, os.path.join(MAPS, 'blank_map.yaml'))]
-        square = Process('move_base_square', [script], folder, cwd=folder)
+        started += [typed('sim', SQUARE[0], folder), typed('nav', SQUARE[1] + NO_RVIZ, folder)]
+        square = typed('move_base_square', SQUARE[2], folder)
         started.append(square)
         wait_until(lambda: not square.running(), 900.0, 'the end of move_base_square.py', watch=started[:2])
         x, y, yaw = true_pose()
@@ -86,16 +92,15 @@ def test_nav_test_with_its_python3_fix_visits_rooms_of_the_test_map(tmp_path):
     master = start_master(folder)
     started = []
     try:
-        test_map = os.path.join(MAPS, 'test_map.yaml')
-        started += [start_world(folder, test_map), start_navigation(folder, test_map)]
-        tour = Process('nav_test', [script, '_rest_time:=1'], folder, cwd=folder)
+        started += [typed('sim', TOUR[0], folder), typed('nav', TOUR[1] + NO_RVIZ, folder)]
+        tour = typed('nav_test', TOUR[2], folder)
         started.append(tour)
         wait_until(lambda: 'Click the 2D Pose Estimate' in tour.output(), 120.0, "nav_test.py's request for a pose",
                    watch=started)
         assert subprocess.call(['rostopic', 'pub', '-1', '/initialpose', 'geometry_msgs/PoseWithCovarianceStamped',
                                 RVIZ_POSE], stdout=subprocess.DEVNULL, timeout=60) == 0
-        wait_until(lambda: tour.output(100000).count('Goal succeeded!') >= 3 or 'Goal failed' in tour.output(100000),
-                   900.0, 'three rooms reached', watch=started)
+        wait_until(lambda: tour.output(100000).count('Goal succeeded!') >= 2 or 'Goal failed' in tour.output(100000),
+                   900.0, 'two rooms reached', watch=started)
         tour.signal_group(signal.SIGINT)  # Ctrl+C: its shutdown cancels the goal and stops the robot
         code = tour.wait(30.0)
         rooms = re.findall(r'Going to: (\w+)', tour.output(100000))

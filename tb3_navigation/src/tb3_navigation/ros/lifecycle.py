@@ -46,8 +46,10 @@ class Life(object):
     """A node's request to end (a flag, its reason) and the end itself.
 
     `stopping` is true once an end was asked for, in any of the ways above.
-    A node with a loop of its own runs `while not life.stopping:` and then
-    calls `finish()`; a node driven by callbacks calls `spin()`.
+    A node with a loop of its own runs `while not life.stopping:`, waits
+    with `sleep` (wall time) or `sleep_sim` (ROS time), never rospy.sleep or
+    rospy.Rate, and then calls `finish()`; a node driven by callbacks calls
+    `spin()`.
     """
 
     def __init__(self):
@@ -68,6 +70,21 @@ class Life(object):
     def sleep(self, seconds):
         """Waits `seconds` of wall time, less if an end is asked for; False then."""
         return not self._stop.wait(seconds) and not rospy.core.is_shutdown_requested()
+
+    def sleep_sim(self, seconds):
+        """Waits `seconds` of ROS time (sim time under /clock), less if an end is asked for or time
+        jumps back; False if an end was asked for. (rospy.sleep and rospy.Rate wait for a clock that
+        stopped, a simulator gone, until rospy itself shuts down: a signal here only sets the flag.)"""
+        condition = rospy.rostime.get_rostime_cond()
+        start = rospy.get_rostime()
+        end = start + rospy.Duration(seconds)
+        while not self.stopping:
+            now = rospy.get_rostime()
+            if now >= end or now < start:
+                return True
+            with condition:
+                condition.wait(0.1)
+        return False
 
     def spin(self):
         """Until an end is asked for (callbacks run in rospy's threads meanwhile); then finish()."""

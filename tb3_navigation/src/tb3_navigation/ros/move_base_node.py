@@ -238,14 +238,12 @@ class MoveBaseNode(object):
                                                                                     stamp)))
 
     def run(self, life):
-        rate = rospy.Rate(self.config.controller_frequency)
+        """A cycle every 1 / controller_frequency s of sim time, until the node is asked to end."""
+        period = 1.0 / self.config.controller_frequency
         while not life.stopping:
+            started = rospy.get_time()
             self.cycle()
-            try:
-                rate.sleep()
-            except rospy.ROSTimeMovedBackwardsException:
-                rospy.logwarn('%s: time went back (a simulation reset): carrying on', NODE)
-            except rospy.ROSInterruptException:
+            if not life.sleep_sim(max(0.0, started + period - rospy.get_time())):
                 break
 
 

@@ -33,7 +33,8 @@ METHODS = ('tb3', 'gmapping', 'cartographer', 'hector', 'karto', 'frontier_explo
 
 class SlamNode(object):
 
-    def __init__(self):
+    def __init__(self, life):
+        self.life = life
         namespace = rospy.get_namespace()
         self.base_frame = rospy.get_param('~base_frame', namespaced('base_footprint', namespace))
         self.odom_frame = rospy.get_param('~odom_frame', namespaced('odom', namespace))
@@ -110,15 +111,10 @@ class SlamNode(object):
 
     def _tf_loop(self):
         """map -> odom every transform_publish_period of sim time (rospy.Timer's thread would end
-        at the first jump back in time)."""
-        while not rospy.core.is_shutdown_requested():
+        at the first jump back in time, and wait on a stopped clock)."""
+        while not self.life.stopping:
             self._send_map_to_odom()
-            try:
-                rospy.sleep(self.transform_publish_period)
-            except rospy.ROSTimeMovedBackwardsException:
-                continue
-            except rospy.ROSInterruptException:
-                return
+            self.life.sleep_sim(self.transform_publish_period)
 
     def _on_dynamic_map(self, _request):
         with self._lock:
@@ -130,5 +126,5 @@ class SlamNode(object):
 
 def main():
     life = lifecycle.init_node(NODE)
-    SlamNode()
+    SlamNode(life)
     life.spin()

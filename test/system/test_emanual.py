@@ -1,0 +1,119 @@
+"""The TurtleBot3 e-manual's mapping and navigation chapters, typed as the README shows them, with rviz.
+
+In one terminal each, through bash, in a fresh HOME, with rviz on a screen
+of the test's own (the launches open it, as on a desktop):
+
+    export TURTLEBOT3_MODEL=burger
+    roslaunch tb3_sim_bringup tb3_world.launch real_time_factor:=0
+    roslaunch tb3_sim_bringup tb3_slam.launch
+    (the robot driven round the pillars: tb3_harness.route_driver, where the learner uses the teleop)
+    rosrun map_server map_saver -f ~/map
+    roslaunch tb3_sim_bringup tb3_navigation.launch map_file:=$HOME/map.yaml
+    2D Pose Estimate at the spawn pose, then a 2D Nav Goal (sent as rviz's tools send them)
+
+The screenshots go to ~/.ros/test_results/tb3_sim_nav/emanual/ (doc/'s
+pictures are copies): what rviz shows at each step must be there, the map
+in the SLAM's, the plan, the costmap and the particles in navigation's.
+"""
+import os
+import shutil
+import signal
+
+import numpy as np
+import pytest
+import rospkg
+import yaml
+
+from tb3_harness.screen import save_png, screenshot, start_xvfb
+from tb3_system_utils import run, wait_until
+
+TIMEOUT = 60.0
+EXPORT = 'export TURTLEBOT3_MODEL=burger'
+SHOTS = os.path.join(rospkg.get_ros_home(), 'test_results', 'tb3_sim_nav', 'emanual')
+GOAL = (0.55, 0.55, 1.5708)
+INITIAL_POSE = ("rostopic pub -1 /initialpose geometry_msgs/PoseWithCovarianceStamped '{header: {frame_id: map}, "
+                "pose: {pose: {position: {x: -2.0, y: -0.5}, orientation: {w: 1.0}}, covariance: [0.25, 0, 0, 0, 0, "
+                "0, 0, 0.25, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, "
+                "0.06853891945]}}'")
+NAV_GOAL = ("rostopic pub -1 /move_base_simple/goal geometry_msgs/PoseStamped '{header: {frame_id: map}, pose: "
+            "{position: {x: 0.55, y: 0.55}, orientation: {z: 0.7071, w: 0.7071}}}'")
+
+
+def bash(command):
+    return ['bash', '-c', '%s && %s' % (EXPORT, command)]
+
+
+def colour_pixels(image, colour, tolerance=25):
+    return int((np.abs(image.astype(int) - np.array(colour)).max(axis=2) <= tolerance).sum())
+
+
+def shot(display, name):
+    image = screenshot(display)
+    os.makedirs(SHOTS, exist_ok=True)
+    save_png(image, os.path.join(SHOTS, name))
+    return image
+
+
+@pytest.fixture
+def desktop(processes, tmp_path, monkeypatch):
+    """A fresh HOME and a screen: (HOME, DISPLAY)."""
+    home = tmp_path / 'home'
+    home.mkdir()
+    xvfb, display = start_xvfb()
+    processes.started.append(xvfb)
+    monkeypatch.setenv('HOME', str(home))
+    monkeypatch.setenv('DISPLAY', display)
+    return str(home), display
+
+
+def test_map_save_and_navigate_as_the_emanual_does(ros_port, processes, desktop):
+    home, display = desktop
+    processes.start_master('roscore', ros_port)
+    sim = processes.start('world', bash('roslaunch tb3_sim_bringup tb3_world.launch real_time_factor:=0'))
+    slam = processes.start('slam', bash('roslaunch tb3_sim_bringup tb3_slam.launch'))
+    assert wait_until(lambda: 'tb3_slam parameters' in slam.output(20000), TIMEOUT), slam.describe()
+    driven = run(['python3', '-m', 'tb3_harness.route_driver', 'world_loop', '--out', os.path.join(home, 'route.json')],
+                 900)
+    assert driven.returncode == 0 and sim.running() and slam.running(), (driven.stdout[-2000:], slam.describe())
+    mapping = shot(display, 'slam.png')
+    # rviz's "map" scheme: occupied cells black, free ones light grey; the scan's flat green.
+    walls, floor = colour_pixels(mapping, (0, 0, 0), 10), colour_pixels(mapping, (205, 205, 205), 30)
+    scan = colour_pixels(mapping, (0, 255, 0), 40)
+    print('MEASURED rviz during SLAM: %d wall pixels, %d floor pixels, %d scan pixels' % (walls, floor, scan))
+    assert walls > 2000 and floor > 20000 and scan > 300
+
+    saved = run(bash('rosrun map_server map_saver -f ~/map'), TIMEOUT)
+    assert saved.returncode == 0, saved.stdout
+    with open(os.path.join(home, 'map.yaml')) as stream:
+        metadata = yaml.safe_load(stream)
+    assert metadata['image'] == os.path.join(home, 'map.pgm') and metadata['resolution'] == pytest.approx(0.05)
+    slam.signal_group(signal.SIGINT)  # Ctrl+C in its terminal
+    assert slam.wait(TIMEOUT) is not None, slam.describe()
+
+    nav = processes.start('navigation', bash('roslaunch tb3_sim_bringup tb3_navigation.launch map_file:=$HOME/map.yaml'))
+    assert wait_until(lambda: nav.output(20000).count('map of') >= 2, TIMEOUT), nav.describe()
+    assert run(bash(INITIAL_POSE), TIMEOUT).returncode == 0
+    result = processes.start('result', ['rostopic', 'echo', '-n', '1', '/move_base/result'])
+    assert run(bash(NAV_GOAL), TIMEOUT).returncode == 0
+    seen = []
+
+    def navigating():
+        image = screenshot(display)
+        plan = colour_pixels(image, (0, 0, 255), 30)
+        if plan > 150:
+            seen[:] = [image, plan]
+        return bool(seen)
+    assert wait_until(navigating, 120, poll=0.5), 'no global plan drawn in rviz'
+    image, plan = seen
+    os.makedirs(SHOTS, exist_ok=True)
+    save_png(image, os.path.join(SHOTS, 'navigation.png'))
+    particles = colour_pixels(image, (255, 25, 0), 30)
+    costmap_cyan = colour_pixels(image, (0, 255, 255), 60)
+    print('MEASURED rviz while navigating: %d plan pixels, %d particle pixels, %d costmap (cyan) pixels'
+          % (plan, particles, costmap_cyan))
+    assert particles > 50 and costmap_cyan > 200
+    assert wait_until(lambda: not result.running(), 180), 'no move_base result within 180 s'
+    outcome = yaml.safe_load(result.output().split('---')[0])
+    print('MEASURED 2D Nav Goal: status %s, %s' % (outcome['status']['status'], outcome['status']['text']))
+    assert outcome['status']['status'] == 3, outcome
+    shutil.copy(os.path.join(home, 'map.pgm'), os.path.join(SHOTS, 'map.pgm'))
