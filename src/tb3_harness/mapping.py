@@ -70,7 +70,7 @@ def map_world(log_dir, output, factor=0.0, profile='realistic', seed=7, world='t
     started = []
 
     def spawn(name, argv):
-        process = Process(name, argv, log_dir)
+        process = Process(name, argv, log_dir, die_with_parent=True)
         started.append(process)
         return process
     try:

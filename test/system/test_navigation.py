@@ -46,9 +46,9 @@ def navigation(tmp_path_factory):
     try:
         os.environ['TURTLEBOT3_MODEL'] = 'burger'
         started.append(Process('sim', ['roslaunch', 'tb3_sim_bringup', 'tb3_world.launch', 'profile:=realistic',
-                                       'real_time_factor:=0'], folder))
+                                       'real_time_factor:=0'], folder, die_with_parent=True))
         started.append(Process('nav', ['roslaunch', 'tb3_sim_bringup', 'tb3_navigation.launch', 'open_rviz:=false'],
-                               folder))
+                               folder, die_with_parent=True))
         rospy.init_node('navigation_test', anonymous=True, disable_signals=True)
         nav = Navigation()
         nav.wait_ready()

@@ -45,7 +45,7 @@ NO_RVIZ = ' open_rviz:=false'
 
 
 def typed(name, command, folder):
-    return Process(name, ['bash', '-c', command], folder, cwd=folder)
+    return Process(name, ['bash', '-c', command], folder, cwd=folder, die_with_parent=True)
 
 
 def true_pose():
