@@ -12,6 +12,13 @@ a drive around the pillars, map_saver; the map in OUTPUT/map.yaml and .pgm, a
 table in OUTPUT/slam.txt and the map under the world's outline with the paths
 in OUTPUT/slam_map.png. As fast as possible unless --real-time-factor says.
 
+With --nav (`make demo DEMO_ARGS="--nav"`) it navigates turtlebot3_world
+(tb3_harness/navigating.py): tb3_world.launch (profile realistic),
+tb3_navigation.launch on the shipped map, a 2D Pose Estimate at the spawn
+pose, four goals around and between the pillars; a table in OUTPUT/nav.txt
+and the map with the true path, the plans and amcl's particles in
+OUTPUT/nav_paths.png. As fast as possible unless --real-time-factor says.
+
 Run inside `source setup.bash`. Starts one master on a free loopback port, then
 for each script does what the tutorial does: start the simulator fresh
 (`roslaunch tb3_sim_bringup tb3_empty_world.launch`), wait for odom ->
@@ -35,7 +42,7 @@ import subprocess
 import sys
 import time
 
-from tb3_harness import calibration, leftovers, mapping, report
+from tb3_harness import calibration, leftovers, mapping, navigating, report
 from tb3_harness.processes import RunError, say, start_master
 from tb3_harness.tutorial import LAUNCH, SCRIPTS, run_script
 from tb3_sim_nav.robot_model import TURTLEBOT3_MODELS
@@ -64,13 +71,15 @@ def parse_args(argv):
                         help='the calibration walkthrough (profile realistic) instead of the tutorial\'s scripts')
     parser.add_argument('--slam', action='store_true',
                         help='map turtlebot3_world (profile realistic) and save the map, instead of the tutorial')
+    parser.add_argument('--nav', action='store_true',
+                        help='navigate turtlebot3_world to four goals (profile realistic), instead of the tutorial')
     args = parser.parse_args(argv)
-    if args.calibrate + args.slam > 1:
-        parser.error('--calibrate and --slam are walkthroughs of their own: one at a time')
-    if args.slam and (args.scripts or args.profile not in (None, 'realistic')):
-        parser.error('--slam drives its own route in profile realistic: no --scripts, no other --profile')
+    if args.calibrate + args.slam + args.nav > 1:
+        parser.error('--calibrate, --slam and --nav are walkthroughs of their own: one at a time')
+    if (args.slam or args.nav) and (args.scripts or args.profile not in (None, 'realistic')):
+        parser.error('--slam and --nav run their own drives in profile realistic: no --scripts, no other --profile')
     if args.real_time_factor is None:
-        args.real_time_factor = 0.0 if args.slam else 1.0
+        args.real_time_factor = 0.0 if (args.slam or args.nav) else 1.0
     if args.calibrate and (args.scripts or args.profile not in (None, 'realistic')):
         parser.error('--calibrate runs its own scripts in profile realistic: no --scripts, no other --profile')
     if not args.real_time_factor >= 0.0:
@@ -120,7 +129,7 @@ def main(argv=None):
     signal.signal(signal.SIGTERM, on_sigterm)
     signal.signal(signal.SIGINT, signal.default_int_handler)  # even if started with SIGINT ignored
 
-    calibrated = mapped = None
+    calibrated = mapped = navigated = None
     scripts = [(name, expected) for name, expected in SCRIPTS if not args.scripts or name in args.scripts]
     master = None
     results, failures = [], []
@@ -137,7 +146,9 @@ def main(argv=None):
             calibrated = calibration.calibrate(args.real_time_factor, log_dir)
         if args.slam:
             mapped = mapping.map_world(log_dir, args.output, factor=args.real_time_factor)
-        for script, expected in scripts if not (args.calibrate or args.slam) else ():
+        if args.nav:
+            navigated = navigating.navigate_world(log_dir, factor=args.real_time_factor)
+        for script, expected in scripts if not (args.calibrate or args.slam or args.nav) else ():
             result, error = run_script(script, expected, args, log_dir)
             results.append(result)
             if error:
@@ -169,6 +180,13 @@ def main(argv=None):
         mapping.draw(mapped, os.path.join(args.output, 'slam_map.png'))
         say('wrote %s, %s and %s' % (mapped.map_yaml, os.path.join(args.output, 'slam.txt'),
                                      os.path.join(args.output, 'slam_map.png')))
+    if navigated is not None:
+        text = '\n'.join(navigating.table(navigated) + ['', 'total wall time %.1f s' % total])
+        print('\n' + text, flush=True)
+        with open(os.path.join(args.output, 'nav.txt'), 'w') as summary:
+            summary.write(text + '\n')
+        navigating.draw(navigated, os.path.join(args.output, 'nav_paths.png'))
+        say('wrote %s and %s' % (os.path.join(args.output, 'nav.txt'), os.path.join(args.output, 'nav_paths.png')))
     model = args.model or os.environ.get('TURTLEBOT3_MODEL', 'burger')
     if results:
         header = ['tb3_sim_nav demo: the tutorial\'s scripts on the pybullet TurtleBot3 %s' % model,
@@ -194,6 +212,10 @@ def main(argv=None):
     if calibrated is not None:
         say('demo done: calibration walkthrough complete')
         return 0
+    if navigated is not None:
+        failed = [o for o in navigated.outcomes if o.state != 'SUCCEEDED']
+        say('demo done: %d of %d goals SUCCEEDED' % (len(navigated.outcomes) - len(failed), len(navigated.outcomes)))
+        return 1 if failed else 0
     if mapped is not None:
         missed = mapped.quality.failures()
         say('demo done: turtlebot3_world mapped%s' % ('; MISSED: ' + '; '.join(missed) if missed else ''))

@@ -179,6 +179,7 @@ def measure(grid, values, obstacles, start, config=QualityConfig()):
 
 # --- the picture ---------------------------------------------------------------
 PATH_COLORS = ('tab:blue', 'tab:orange', 'tab:green', 'tab:red', 'tab:purple', 'tab:brown')
+CLOUD_COLORS = ('tab:pink', 'tab:olive', 'tab:cyan', 'tab:gray')
 PIXELS_PER_METRE = 80  # a 5 m world in 400 px: every 0.05 m cell seen
 
 
@@ -191,9 +192,11 @@ def _grey(values):
     return grey
 
 
-def render_png(filename, grid, values, obstacles=(), paths=(), title=None, scan_height=BURGER_SCAN_HEIGHT):
-    """A PNG of the map in grey with the world's outline (at the lidar's height) in red over it, and
-    `paths` (a list of [(x, y), ...], or a dict label -> path) in colours."""
+def render_png(filename, grid, values, obstacles=(), paths=(), title=None, scan_height=BURGER_SCAN_HEIGHT,
+               clouds=()):
+    """A PNG of the map in grey with the world's outline (at the lidar's height) in red over it,
+    `paths` (a list of [(x, y), ...], or a dict label -> path) in colours, and `clouds` (a dict
+    label -> [(x, y), ...]) as dots."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.patches import Circle, Polygon
@@ -222,7 +225,11 @@ def render_png(filename, grid, values, obstacles=(), paths=(), title=None, scan_
     for index, (label, path) in enumerate(labelled):
         path = np.asarray(path, dtype=float).reshape(-1, 2)
         axis.plot(path[:, 0], path[:, 1], color=PATH_COLORS[index % len(PATH_COLORS)], linewidth=1.5, label=label)
-    if isinstance(paths, dict) and paths:
+    for index, (label, points) in enumerate(dict(clouds).items()):
+        points = np.asarray(points, dtype=float).reshape(-1, 2)
+        axis.scatter(points[:, 0], points[:, 1], s=1, alpha=0.4, color=CLOUD_COLORS[index % len(CLOUD_COLORS)],
+                     label=label)
+    if (isinstance(paths, dict) and paths) or clouds:
         axis.legend(loc='upper right', fontsize=8, framealpha=0.9)
     corners = turn.transform([(x0, y0), (x0 + width, y0), (x0 + width, y0 + height), (x0, y0 + height)])
     axis.set_xlim(corners[:, 0].min(), corners[:, 0].max())

@@ -11,6 +11,7 @@ came to the world's obstacles.
 """
 import dataclasses
 import math
+import os
 import threading
 import time
 
@@ -166,16 +167,138 @@ def clearance(path, obstacles, footprint):
     """The least distance (m) from the robot's footprint (a polygon [(x, y)] in base_footprint)
     to the world's obstacles (world_file Obstacles cut at the lidar's height), along `path`
     ([t, x, y, yaw] samples): the judge's check that the robot never came too close."""
+    return closest(path, obstacles, footprint)[0]
+
+
+def closest(path, obstacles, footprint):
+    """(clearance, the path's sample where the footprint came closest)."""
     import numpy as np
     from tb3_navigation.costmap import outline as footprint_outline
     from tb3_sim_nav.world_map import in_plane, signed_distance
     outline = footprint_outline(footprint, 0.01)
     cut = in_plane(obstacles)
-    least = math.inf
+    least, where = math.inf, None
     for sample in path:
         cos, sin = math.cos(sample[3]), math.sin(sample[3])
         points = np.stack((sample[1] + cos * outline[:, 0] - sin * outline[:, 1],
                            sample[2] + sin * outline[:, 0] + cos * outline[:, 1]), axis=-1)
-        least = min(least, float(signed_distance(cut, points).min()))
-    return least
+        distance = float(signed_distance(cut, points).min())
+        if distance < least:
+            least, where = distance, tuple(sample)
+    return least, where
 
+
+
+#: The demo's and the bench's goals in turtlebot3_world, around and between the pillars, from tb3_world's spawn.
+WORLD_SPAWN = (-2.0, -0.5, 0.0)
+WORLD_GOALS = [(-0.55, -0.55, 0.0), (0.55, 0.55, math.pi / 2), (1.65, -0.55, -math.pi / 2), (-0.55, 1.65, math.pi)]
+BURGER_FOOTPRINT = [(-0.105, -0.105), (-0.105, 0.105), (0.041, 0.105), (0.041, -0.105)]
+
+
+@dataclasses.dataclass
+class NavigationRun(object):
+    """One run of the navigation chapter: each goal's Outcome, the map, the recordings, and what it cost
+    (CPU shares of a core: amcl and move_base together, the simulator; wall and sim seconds of the goals)."""
+    factor: float
+    outcomes: list
+    grid: object
+    values: object
+    truth: list
+    plans: list
+    clouds: list
+    spreads: list
+    stack_cpu: float
+    sim_cpu: float
+    wall_seconds: float
+    sim_seconds: float
+    clearance: float
+    closest: tuple  # the true pose [t, x, y, yaw] where the footprint came closest
+
+
+def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD_GOALS, spawn=WORLD_SPAWN):
+    """tb3_world.launch and tb3_navigation.launch (its shipped map), a 2D Pose Estimate at the spawn
+    pose, then `goals` one after the other; the caller is a rospy node (following /clock) of a master
+    of its own. RunError if a launch fails."""
+    import rosgraph
+    import rospkg
+    import rospy
+    from tb3_navigation.map_files import load_map
+    from tb3_sim_nav.world_file import load_world
+    from .mapping import _node_pid
+    from .measure import cpu_seconds
+    from .processes import Process, wait_until
+    rosgraph.Master('/tb3_harness').setParam('/tb3_sim/seed', seed)
+    rosgraph.Master('/tb3_harness').setParam('/amcl/seed', seed)
+    package = rospkg.RosPack().get_path('tb3_sim_nav')
+    started = []
+    try:
+        started.append(Process('sim', ['roslaunch', 'tb3_sim_bringup', 'tb3_world.launch', 'profile:=%s' % profile,
+                                       'real_time_factor:=%g' % factor], log_dir, die_with_parent=True))
+        started.append(Process('nav', ['roslaunch', 'tb3_sim_bringup', 'tb3_navigation.launch', 'open_rviz:=false'],
+                               log_dir, die_with_parent=True))
+        wait_until(lambda: started[1].output(20000).count('map of') >= 2, 60.0, 'the map in amcl and move_base',
+                   watch=started)
+        navigation = Navigation()
+        navigation.wait_ready()
+        navigation.set_pose(*spawn)
+        pids = [_node_pid(name) for name in ('/amcl', '/move_base', '/tb3_sim')]
+        cpu = [cpu_seconds(pid) for pid in pids]
+        wall, sim = time.monotonic(), rospy.get_time()
+        outcomes = []
+        for goal in goals:
+            outcome = navigation.go(*goal)
+            say_goal(len(outcomes) + 1, outcome)
+            outcomes.append(outcome)
+        wall, sim = time.monotonic() - wall, rospy.get_time() - sim
+        used = [cpu_seconds(pid) - before for pid, before in zip(pids, cpu)]
+        navigation.close()
+    finally:
+        for process in reversed(started):
+            process.stop()
+    saved = load_map(os.path.join(package, 'maps', 'turtlebot3_world.yaml'))
+    obstacles = load_world('turtlebot3_world', os.path.join(package, 'worlds')).obstacles
+    truth = list(navigation.truth)
+    return NavigationRun(factor, outcomes, saved.grid, saved.values, truth, list(navigation.plans),
+                         list(navigation.clouds), list(navigation.spreads), (used[0] + used[1]) / wall,
+                         used[2] / wall, wall, sim, *closest(truth, obstacles, BURGER_FOOTPRINT))
+
+
+def say_goal(number, outcome):
+    from .processes import say
+    say('goal %d (%.2f, %.2f, %.2f): %s after %.1f s of sim time, truly %.3f m and %.3f rad off'
+        % ((number,) + tuple(outcome.goal) + (outcome.state, outcome.sim_seconds, outcome.xy_error,
+                                               outcome.yaw_error)))
+
+
+def table(run):
+    lines = ['turtlebot3_world navigated by tb3_navigation.launch (profile realistic, shipped map, 2D Pose '
+             'Estimate at the spawn pose), real_time_factor %g' % run.factor,
+             '  goal (x, y, yaw)         outcome    sim s   true error (m, rad)']
+    for outcome in run.outcomes:
+        lines.append('  (%5.2f, %5.2f, %5.2f)   %-9s  %5.1f   %.3f, %.3f' % (
+            tuple(outcome.goal) + (outcome.state, outcome.sim_seconds, outcome.xy_error, outcome.yaw_error)))
+    spread = [s for s in run.spreads]
+    if spread:
+        lines.append("  amcl's particles: %d at first, spread %.2f m; %d at the end, spread %.3f m"
+                     % (spread[0][4], max(spread[0][1:3]), spread[-1][4], max(spread[-1][1:3])))
+    lines += ['  footprint never nearer than %.3f m to a pillar or wall (at %.1f s: x %.2f, y %.2f, yaw %.2f)'
+              % ((run.clearance,) + tuple(run.closest)),
+              '  %.1f s of sim time in %.1f s wall; amcl and move_base %.0f %% of a core, the simulator %.0f %%'
+              % (run.sim_seconds, run.wall_seconds, 100 * run.stack_cpu, 100 * run.sim_cpu)]
+    return lines
+
+
+def draw(run, filename):
+    """The map with the world's outline, the true path, the plans and a few particle clouds."""
+    import rospkg
+    from tb3_sim_nav.world_file import load_world
+    from .map_quality import render_png
+    package = rospkg.RosPack().get_path('tb3_sim_nav')
+    paths = {'true path': [p[1:3] for p in run.truth]}
+    for index, (_, plan) in enumerate(run.plans[::max(1, len(run.plans) // 4)][:4]):
+        paths['plan %d' % (index + 1)] = plan
+    clouds = dict(('particles at %.0f s' % stamp, points) for stamp, points in run.clouds[:3])
+    render_png(filename, run.grid, run.values, load_world('turtlebot3_world', os.path.join(package, 'worlds')).obstacles,
+               paths=paths, clouds=clouds,
+               title='turtlebot3_world navigated (profile realistic): %d of %d goals SUCCEEDED'
+                     % (sum(o.state == 'SUCCEEDED' for o in run.outcomes), len(run.outcomes)))
