@@ -34,6 +34,7 @@ class Outcome(object):
     xy_error: float
     yaw_error: float
     path: list
+    amcl_error: float = math.nan  # m: amcl's last pose of the goal against the truth at its time
 
 
 class Navigation(object):
@@ -160,7 +161,17 @@ class Navigation(object):
             path = [sample[:] for sample in self.truth[first:]]
         state = STATES.get(self.client.get_state(), str(self.client.get_state()))
         return Outcome((x, y, yaw), state, self.client.get_goal_status_text(), took, truth,
-                       math.hypot(truth[1] - x, truth[2] - y), abs(normalize(truth[3] - yaw)), path)
+                       math.hypot(truth[1] - x, truth[2] - y), abs(normalize(truth[3] - yaw)), path,
+                       self.amcl_error(start))
+
+    def amcl_error(self, since):
+        """Distance (m) of amcl's newest pose (if any came after `since`) from the truth at its stamp."""
+        with self._lock:
+            if not self.amcl or self.amcl[-1][0] < since or not self.truth:
+                return math.nan
+            estimate = self.amcl[-1]
+            then = min(self.truth, key=lambda sample: abs(sample[0] - estimate[0]))
+        return math.hypot(estimate[1] - then[1], estimate[2] - then[2])
 
 
 def clearance(path, obstacles, footprint):
@@ -265,9 +276,9 @@ def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD
 
 def say_goal(number, outcome):
     from .processes import say
-    say('goal %d (%.2f, %.2f, %.2f): %s after %.1f s of sim time, truly %.3f m and %.3f rad off'
+    say('goal %d (%.2f, %.2f, %.2f): %s after %.1f s of sim time, truly %.3f m and %.3f rad off (amcl %.3f m off)'
         % ((number,) + tuple(outcome.goal) + (outcome.state, outcome.sim_seconds, outcome.xy_error,
-                                               outcome.yaw_error)))
+                                               outcome.yaw_error, outcome.amcl_error)))
 
 
 def table(run):

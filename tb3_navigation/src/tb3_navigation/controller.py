@@ -32,7 +32,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from tb3_navigation.pose2d import normalize_angle
-from tb3_navigation.trajectory_scoring import TrajectoryScorer, velocity_samples
+from tb3_navigation.trajectory_scoring import GOAL_ZONE, TrajectoryScorer, velocity_samples
 
 EPSILON = 1e-4  # m/s, rad/s: SimpleTrajectoryGenerator's slack on the velocity limits
 #: Where the controller aims, as a share of xy_goal_tolerance and yaw_goal_tolerance. DWA stops the
@@ -74,6 +74,7 @@ class DwaConfig:
     path_distance_bias: float = 32.0  # weight of staying on the global plan
     goal_distance_bias: float = 20.0  # weight of getting to the local goal
     occdist_scale: float = 0.02  # weight of keeping off obstacles
+    obstacle_clearance: float = 0.1  # m (ours): trajectories keep this far from obstacles whenever one can
     forward_point_distance: float = 0.325  # m: the point ahead scored too
     stop_time_buffer: float = 0.2  # s: a trajectory must stop this long before an obstacle
     scaling_speed: float = 0.25  # m/s: above it the footprint is scaled up
@@ -208,7 +209,7 @@ class DwaController(object):
             command = self._stop_and_rotate(pose, velocity, local, plan[-1][2])
         else:
             self._rotating = False
-            command = self._dwa(pose, velocity, local)
+            command = self._dwa(pose, velocity, local, plan[-1])
         return self._safe(command)
 
     def _local_plan(self, pose, plan):
@@ -264,7 +265,7 @@ class DwaController(object):
             return Command(0.0, 0.0, False, reason='%s would collide' % what)
         return Command(v, w, True, trajectories[0])
 
-    def _dwa(self, pose, velocity, local):
+    def _dwa(self, pose, velocity, local, goal):
         config = self.config
         period = config.sim_period
         low_v = max(config.min_vel_x, velocity[0] - config.acc_lim_x * period)
@@ -280,7 +281,8 @@ class DwaController(object):
         samples = samples[[self._allowed(v, w) for v, w in samples]] if self._flags else samples
         if not len(samples):
             return Command(0.0, 0.0, False, reason='no velocity in the dynamic window')
-        costs, trajectories = self.scorer.score(pose, samples, self.scorer.maps(pose, local))
+        far = math.hypot(goal[0] - pose[0], goal[1] - pose[1]) > GOAL_ZONE
+        costs, trajectories = self.scorer.score(pose, samples, self.scorer.maps(pose, local), clearance=far)
         valid = np.flatnonzero(costs >= 0)
         if not len(valid):
             return Command(0.0, 0.0, False, reason='every trajectory collides or leaves the plan')

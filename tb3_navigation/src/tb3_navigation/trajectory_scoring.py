@@ -12,6 +12,11 @@ angular_sim_granularity rad, whichever gives more). Its cost is the sum
     local goal) and to the local goal pushed forward_point_distance beyond
     it along the robot's bearing to it (goal front);
 
+plus CLOSE if its footprint comes nearer than obstacle_clearance to an
+obstacle cell (ours: DWA cut round the pillars with its footprint 6 cm
+from them, following a plan that kept 25 cm; a trajectory that keeps the
+clearance wins whenever one exists, and one that does not is still allowed,
+so that goals near walls stay reachable);
 cells counted in 4-neighbour steps around lethal, inscribed and unknown
 cells (base_local_planner's MapGrid). It is rejected (cost < 0) if its
 footprint, scaled up past scaling_speed, touches a lethal or unknown cell or
@@ -29,6 +34,8 @@ from tb3_navigation.costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION
 from tb3_navigation.grid_graph import build, shortest_paths
 
 CHUNK = 64  # trajectories whose footprints are checked together
+CLOSE = 1e4  # added to a trajectory nearer to an obstacle than obstacle_clearance: more than any other term
+GOAL_ZONE = 0.5  # m from the goal within which the clearance is not asked for
 
 
 def velocity_samples(low, high, count):
@@ -47,6 +54,16 @@ class TrajectoryScorer(object):
 
     def __init__(self, costmap, config):
         self.costmap, self.config = costmap, config
+
+    def close_cost(self):
+        """The cost of a cell whose centre is obstacle_clearance plus half a cell from the nearest
+        obstacle cell's: a footprint over such a cell or a dearer one is too close."""
+        from tb3_navigation.costmap import inflation_costs
+        costmap = self.costmap
+        resolution = costmap.grid.resolution
+        cells = (self.config.obstacle_clearance + resolution / 2.0) / resolution
+        return float(inflation_costs(np.array([cells]), resolution, costmap.inscribed_radius,
+                                     costmap.config.inflation_radius, costmap.config.cost_scaling_factor)[0])
 
     def maps(self, pose, local):
         """Cells (as step counts) from the plan, from the local goal and from the local goal
@@ -85,8 +102,9 @@ class TrajectoryScorer(object):
         y = pose[1] + np.concatenate((np.zeros((len(samples), 1)), np.cumsum(moves * np.sin(headings), 1)[:, :-1]), 1)
         return np.stack((x, y, headings), axis=-1)
 
-    def score(self, pose, samples, maps, check_all=False):
-        """Costs (n,) of the samples' trajectories (< 0: rejected) and the trajectories."""
+    def score(self, pose, samples, maps, check_all=False, clearance=True):
+        """Costs (n,) of the samples' trajectories (< 0: rejected) and the trajectories;
+        `clearance` False: obstacle_clearance not asked for (near the goal)."""
         config, costmap = self.config, self.costmap
         trajectories = self.trajectories(pose, samples)
         ends = trajectories[:, -1, :]
@@ -110,13 +128,15 @@ class TrajectoryScorer(object):
         order = np.flatnonzero(~rejected)
         order = order[np.argsort(costs[order], kind='stable')]
         best = math.inf
+        close_cost = self.close_cost() if clearance and config.obstacle_clearance > 0 else 0.0
         for start in range(0, len(order), CHUNK):
             chunk = order[start:start + CHUNK]
             if not check_all and costs[chunk[0]] > best:
                 costs[order[start:]] = math.inf  # valid but never better: left unscored
                 break
             obstacle = self.obstacle_costs(trajectories[chunk], samples[chunk])
-            costs[chunk] = np.where(obstacle < 0, -1.0, costs[chunk] + config.occdist_scale * obstacle)
+            close = (obstacle >= close_cost) & (close_cost > 0)
+            costs[chunk] = np.where(obstacle < 0, -1.0, costs[chunk] + config.occdist_scale * obstacle + CLOSE * close)
             if np.any(obstacle >= 0):
                 best = min(best, costs[chunk][obstacle >= 0].min())
         return costs, trajectories
