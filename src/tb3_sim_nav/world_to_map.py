@@ -1,14 +1,16 @@
-"""world_to_map WORLD -f NAME [--resolution 0.05]: a world file rasterised into a map_server map. No master needed.
+"""world_to_map WORLD -f NAME [--start X Y] [--resolution 0.05]: a world file rasterised into a map_server map. No master needed.
 
-The map is what a perfect mapping run would give: the world cut at the
-Burger's lidar height (world_map.map_of_world: a cell is occupied if an
-obstacle covers any of it, free otherwise), over the world's outline plus a
-margin. It is written as map_saver writes maps (NAME.pgm and NAME.yaml),
-except that the YAML names its image by its bare file name, so the two files
-can move together (map_saver writes the path -f gave it). The maps in maps/
-were made so:
+The map is the world cut at the Burger's lidar height (world_map.map_of_world:
+a cell is occupied if an obstacle covers any of it, free otherwise), over the
+world's outline plus a margin; with --start, the map a perfect mapping run
+from (X, Y) would give: what is reachable from there free, the surfaces seen
+from it occupied (one cell thick, as a SLAM's map), the rest unknown. It is
+written as map_saver writes maps (NAME.pgm and NAME.yaml), except that the
+YAML names its image by its bare file name, so the two files can move
+together (map_saver writes the path -f gave it). The maps in maps/ were made
+so, each from its launch's spawn pose:
 
-    rosrun tb3_sim_nav world_to_map turtlebot3_world -f maps/turtlebot3_world
+    rosrun tb3_sim_nav world_to_map turtlebot3_world -f maps/turtlebot3_world --start -2.0 -0.5
 """
 import argparse
 import os
@@ -41,6 +43,8 @@ def main(argv=None):
     parser = argparse.ArgumentParser(prog='world_to_map', description=__doc__.split('\n')[0])
     parser.add_argument('world', help='a world by name (worlds/NAME.yaml) or the path of a world file')
     parser.add_argument('-f', dest='name', required=True, help='write NAME.pgm and NAME.yaml')
+    parser.add_argument('--start', type=float, nargs=2, metavar=('X', 'Y'),
+                        help='map only what is seen from the space reachable from (X, Y), as a SLAM would')
     parser.add_argument('--resolution', type=_positive, default=0.05, help='metres per cell (0.05)')
     parser.add_argument('--margin', type=float, default=0.5, help='free border around the world, m (0.5)')
     parser.add_argument('--height', type=float, default=BURGER_SCAN_HEIGHT,
@@ -48,7 +52,8 @@ def main(argv=None):
     options = parser.parse_args(sys.argv[1:] if argv is None else argv)
     try:
         world = load_world(options.world, _worlds_folder())
-        grid, values = map_of_world(world.obstacles, options.resolution, options.margin, options.height)
+        grid, values = map_of_world(world.obstacles, options.resolution, options.margin, options.height,
+                                    options.start)
         pgm, yaml_path = save_map(grid, values, SaverConfig(mapname=options.name),
                                   image=os.path.basename(options.name) + '.pgm')
     except (WorldError, MapFileError, ValueError) as error:

@@ -128,19 +128,19 @@ def test_at_the_goal_it_stops_then_turns_in_place_then_holds():
     _, controller = open_field(config)
     plan = straight_plan(0.5, 0.0)
     plan[-1, 2] = math.pi / 2  # the goal's yaw
-    at_goal = (0.5 - 0.01, 0.0, 0.0)  # within 0.3 of xy_goal_tolerance: the approach is over
+    at_goal = (0.5 - 0.005, 0.0, 0.0)  # within ARRIVAL (0.2) of xy_goal_tolerance: the approach is over
     command = controller.compute(at_goal, (0.2, 0.0), plan)  # still moving: slow down first
     assert command.ok and command.w == 0.0 and command.v == pytest.approx(0.0)
     assert not controller.is_goal_reached(at_goal, (0.2, 0.0), plan)
     turns = [controller.compute(at_goal, (0.0, w), plan).w for w in (0.0, 0.32, 0.64)]
     assert turns == pytest.approx([0.32, 0.64, 0.96])  # stopped: turn left, within acc_lim_theta
-    # Within the yaw tolerance (0.17) but not yet within 0.3 of it: it turns on, just what is left.
-    nearly = (0.5 - 0.01, 0.0, math.pi / 2 - 0.1)
+    # Within the yaw tolerance (0.17) but not yet within ARRIVAL of it: it turns on, just what is left.
+    nearly = (0.5 - 0.005, 0.0, math.pi / 2 - 0.1)
     command = controller.compute(nearly, (0.0, 0.3), plan)
     # 0.1 rad left: 1.0 rad/s would turn it in one period, but from 0.3 rad/s acc_lim_theta allows 0.62.
     assert command.v == 0.0 and command.w == pytest.approx(0.3 + 0.32)
     assert not controller.is_goal_reached(nearly, (0.0, 0.0), plan)
-    facing = (0.5 - 0.01, 0.0, math.pi / 2 - 0.05)
+    facing = (0.5 - 0.005, 0.0, math.pi / 2 - 0.03)
     command = controller.compute(facing, (0.0, 0.5), plan)
     assert (command.v, command.w) == (0.0, pytest.approx(0.5 - 0.32))  # brakes as hard as acc_lim_theta allows
     assert controller.is_goal_reached(facing, (0.0, 0.05), plan)

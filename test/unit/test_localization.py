@@ -14,6 +14,7 @@ import pytest
 from conftest import REPO
 from drives import WORLD_LOOP, WORLD_LOOP_START, record_drive
 from tb3_navigation.grid import Grid
+from tb3_navigation.map_files import load_map
 from tb3_navigation.localization import (RVIZ_COVARIANCE, Amcl, AmclConfig, covariance_3x3,
                                          covariance_6x6)
 from tb3_navigation.pose2d import compose, normalize_angle
@@ -319,3 +320,24 @@ def test_recovery_alphas_add_random_particles_when_the_likelihood_drops(world, l
                 far.append(np.mean(np.hypot(*(amcl.particles[:, :2] - centre).T) > 1.0))
         spread[alphas] = max(far)
     assert spread[(0.0, 0.0)] < 0.01 and spread[(0.001, 0.1)] > 0.05
+
+
+def test_the_estimate_matched_to_the_map_is_nearer_the_truth_than_the_clouds_mean(loop):
+    """On the shipped map (a perfect SLAM's, walls one cell thick), after the loop's first quarter."""
+    loaded = load_map(str(REPO / 'maps' / 'turtlebot3_world.yaml'))
+    quarter = travelled(loop)[-1] / 4.0
+    errors = {}
+    for refine in (False, True):
+        found = []
+        for seed in (3, 4):
+            amcl = Amcl(AmclConfig(refine_estimate=refine), loaded.grid, loaded.values, seed=seed)
+            amcl.initialise(loop.truth[0], TIGHT)
+            _, updates = run(amcl, loop)
+            late = travelled(loop)[updates[:, 0].astype(int)] > quarter
+            found.append(updates[late, 1])
+        errors[refine] = np.concatenate(found)
+    figures = {refine: np.percentile(values, [50, 95, 100]) for refine, values in errors.items()}
+    print('MEASURED estimate error, cm (median, p95, worst): the cloud\'s mean %s, matched %s'
+          % tuple(np.round(100 * figures[refine], 1).tolist() for refine in (False, True)))
+    assert figures[True][0] < 0.02 and figures[True][1] < 0.035 and figures[True][2] < 0.05
+    assert figures[True][0] < figures[False][0]

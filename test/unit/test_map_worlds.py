@@ -23,8 +23,8 @@ WORLDS = str(REPO / 'worlds')
 SCAN_OFFSET = (-0.032, 0.182)  # Burger: base_scan's x and height in base_footprint
 AGREE = 0.01                   # m: a beam agrees with the march through the image within this
 AGREEING_SHARE = 0.95          # of the beams that hit a wall
-MAP_OF_WORLD_AGREE = 0.071     # m: a 0.05 m cell's diagonal
-MAP_OF_WORLD_SHARE = 0.85      # of all beams: the pillars' squares of cells catch beams grazing them (89 % measured)
+MAP_OF_WORLD_AGREE = 0.121     # m: a 0.05 m cell plus its diagonal
+MAP_OF_WORLD_SHARE = 0.85      # of all beams: the pillars' rings of cells catch beams grazing them
 GRAZING = 0.02                 # share of beams that may pass a pixel's corner in one ray cast and not the other
 LOAD_LIMIT = 2.0               # s: the issue's bound on loading a map world
 # Lidar cost against turtlebot3_world's. Measured 1.13-1.15 (best of 5): the issue's "no more" is missed by
@@ -134,9 +134,11 @@ def test_a_saved_map_of_a_world_is_a_world_whose_lidar_reads_as_the_original(mak
     agree[both] = np.abs(error) <= MAP_OF_WORLD_AGREE
     print('MEASURED turtlebot3_world map vs world file: %d beams hit in both, median %+.3f m; %d of %d agree '
           'within %.3f m' % (both.sum(), np.median(error), agree.sum(), agree.size, MAP_OF_WORLD_AGREE))
-    # A cell is occupied where a wall or pillar holds its centre: surfaces read up to half a cell's
-    # diagonal nearer or further (0.035 m), as much one way as the other.
-    assert both.sum() > 300 and abs(np.median(error)) <= 0.01 and np.percentile(np.abs(error), 90) <= 0.04
+    # The shipped maps are a perfect SLAM's (world_to_map --start): the cells a surface runs through,
+    # on the open side, occupied. Built into boxes, those surfaces stand up to a cell in front of the
+    # world's (median a cell: walls lie on cell edges), never behind it; beams that pass a round pillar
+    # by its ring of cells' corners read that corner.
+    assert both.sum() > 300 and error.max() <= 0.002 and np.median(error) >= -0.06
     assert agree.sum() >= MAP_OF_WORLD_SHARE * agree.size
 
 
@@ -217,11 +219,16 @@ def test_a_bad_map_as_world_names_the_file_and_the_key(tmp_path):
 
 
 # --- world_to_map and the rasterisation behind it ---------------------------------------------
-@pytest.mark.parametrize('world', ['turtlebot3_world', 'turtlebot3_house', 'turtlebot3_stage_1', 'turtlebot3_stage_2',
-                                   'turtlebot3_stage_3', 'turtlebot3_stage_4'])
+SPAWNS = {'turtlebot3_world': (-2.0, -0.5), 'turtlebot3_house': (-3.0, 1.0), 'turtlebot3_stage_1': (0.0, 0.0),
+          'turtlebot3_stage_2': (0.0, 0.0), 'turtlebot3_stage_3': (0.0, 0.0), 'turtlebot3_stage_4': (-0.7, 0.0)}
+
+
+@pytest.mark.parametrize('world', sorted(SPAWNS))
 def test_the_shipped_maps_are_what_world_to_map_makes_today(world, tmp_path, capsys):
+    """Each map in maps/ is world_to_map's from its launch's spawn pose (x_pos, y_pos)."""
     from tb3_sim_nav.world_to_map import main
-    assert main([world, '-f', str(tmp_path / world)]) == 0
+    start = ['%g' % value for value in SPAWNS[world]]
+    assert main([world, '-f', str(tmp_path / world), '--start'] + start) == 0
     assert 'world_to_map: %s -> ' % world in capsys.readouterr().out
     for suffix in ('.pgm', '.yaml'):
         assert (tmp_path / (world + suffix)).read_bytes() == (REPO / 'maps' / (world + suffix)).read_bytes()
@@ -238,20 +245,10 @@ def test_world_to_map_names_a_missing_world_and_takes_a_resolution(tmp_path, cap
         main(['turtlebot3_stage_1', '-f', str(tmp_path / 's'), '--resolution', '0'])
 
 
-def covered_by(obstacles, grid, cells, per_side=16):
-    """True per cell (n, 2) where one of per_side x per_side samples lies in one of `obstacles`."""
-    from tb3_sim_nav.world_map import occupied
-    sub = (np.arange(per_side) + 0.5) / per_side - 0.5
-    offsets = np.stack(np.meshgrid(sub, sub), -1).reshape(-1, 2) * grid.resolution
-    points = grid.centres(np.asarray(cells).reshape(-1, 2))[:, None, :] + offsets
-    return occupied(obstacles, points.reshape(-1, 2)).reshape(len(points), -1).any(axis=1)
-
-
-def test_rasterise_marks_the_cells_whose_centres_obstacles_hold_and_all_a_thin_one_covers():
-    """A thick obstacle marks exactly the cells whose centre it holds; one too thin to hold any (a
-    1 cm panel) marks every cell it covers, against samples in each cell, 16 x 16 (3 mm apart: every
-    obstacle reaching one lies more than world_map.OVERLAP, 1 mm, into the cell), and a finer grid of
-    samples confirms each cell marked beyond those."""
+def test_rasterise_marks_every_cell_an_obstacle_covers_and_hardly_more():
+    """Against samples in each cell, 16 x 16 (3 mm apart: every obstacle reaching one lies more than
+    world_map.OVERLAP, 1 mm, into the cell): no covered cell missed, thin and turned walls included; and
+    every cell marked beyond those, a finer grid of samples finds covered."""
     from tb3_sim_nav.world_file import Obstacle
     from tb3_sim_nav.world_map import occupied
     rng = np.random.default_rng(11)
@@ -264,20 +261,20 @@ def test_rasterise_marks_the_cells_whose_centres_obstacles_hold_and_all_a_thin_o
                                   rng.uniform(-3, 3), (1, 1, 1, 1), ''))
         obstacles.append(Obstacle('cylinder', (rng.uniform(0.02, 0.3), 0.5), (y, x, 0.25), 0.0, (1, 1, 1, 1), ''))
     def covered(cells, per_side):
-        return covered_by(obstacles, grid, cells, per_side)
+        """True per cell (n, 2) where one of per_side x per_side samples lies in an obstacle."""
+        sub = (np.arange(per_side) + 0.5) / per_side - 0.5
+        offsets = np.stack(np.meshgrid(sub, sub), -1).reshape(-1, 2) * grid.resolution
+        points = grid.centres(cells)[:, None, :] + offsets
+        return occupied(obstacles, points.reshape(-1, 2)).reshape(len(cells), -1).any(axis=1)
 
     cells = np.stack(np.meshgrid(np.arange(grid.width), np.arange(grid.height)), -1).reshape(-1, 2)
-    centres = grid.centres(cells)
-    thin = [o for o in obstacles if (min(o.size[:2]) if o.kind == 'box' else 2 * o.size[0]) < 2 * grid.resolution]
-    thick = [o for o in obstacles if o not in thin]
-    assert 'thin' in [o.name for o in thin] and thick
-    assert np.array_equal(rasterise(thick, grid).ravel(), occupied(thick, centres))
-    marked = rasterise(thin, grid).ravel()
-    sampled = covered_by(thin, grid, cells)
-    assert not (sampled & ~marked).any()  # nothing a thin one covers is missed
+    marked = rasterise(obstacles, grid).ravel()
+    sampled = covered(cells, 16)
+    assert not (sampled & ~marked).any()  # nothing covered is missed
     # What the coarse samples did not see (slivers under 3 mm) a 0.4 mm grid of samples confirms.
-    assert covered_by(thin, grid, cells[marked & ~sampled], 125).all()
-    marked = rasterise(obstacles, grid)
+    disputed = cells[marked & ~sampled]
+    assert covered(disputed, 125).all()
+    marked = marked.reshape(grid.shape)
     # The wall 0.05 m thick on cell edges (y 0.55..0.60 on a grid from -1.2) fills one row, not three.
     ix, iy = grid.to_cells((0.0, 0.575))
     assert marked[iy - 1:iy + 2, ix].tolist() == [False, True, False]

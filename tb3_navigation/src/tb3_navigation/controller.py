@@ -42,8 +42,8 @@ EPSILON = 1e-4  # m/s, rad/s: SimpleTrajectoryGenerator's slack on the velocity 
 #: tolerance, or within PASSED of it once the robot drives away from the goal again (it went by:
 #: turning back would only oscillate), and the goal counts as reached only once the turn in place
 #: has brought the heading within ARRIVAL of the yaw tolerance.
-ARRIVAL = 0.3
-PASSED = 0.5
+ARRIVAL = 0.2
+PASSED = 0.4
 
 
 @dataclass(frozen=True)

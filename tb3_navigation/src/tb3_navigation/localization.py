@@ -28,6 +28,18 @@ Where this differs from amcl, and why:
   count, which KLD changes from one update to the next.
 - The estimate's covariance is the whole set's, as amcl publishes it in
   amcl_pose; the heaviest cluster's is there too.
+- The estimate's pose is the heaviest cluster's mean matched to the map by
+  the update's scan (tb3_navigation.matcher: point-to-line Gauss-Newton to
+  lines fitted through the map's occupied cells, pulled towards the mean as
+  REFINE_PRIOR beams would), when the match keeps half the beams on walls
+  and moves the mean less than 0.1 m and 0.1 rad; else the mean itself
+  (refine_estimate false: always). With TurtleBot3's flat beam model
+  (sigma_hit 0.2, z_rand 0.5) the cloud is a few cm wide and its mean
+  wanders in it: on the loop round turtlebot3_world's pillars (6 seeds,
+  shipped map, rviz's initial covariance; after the first quarter) the mean
+  was median 1.4, p95 3.6, worst 4.9 cm off the truth, and a robot stopping
+  on it ended up to 6.5 cm from its goal (tolerance 0.05 m); matched, see
+  test_localization's figures. The particles are left as they are.
 """
 import dataclasses
 import math
@@ -35,6 +47,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from tb3_navigation import matcher
 from tb3_navigation import particles as pf
 from tb3_navigation.likelihood import LikelihoodField, LikelihoodFieldModel
 from tb3_navigation.pose2d import compose, inverse, normalize_angle
@@ -44,6 +57,11 @@ from tb3_navigation.scan import endpoints
 RVIZ_COVARIANCE = np.diag([0.25, 0.25, (math.pi / 12.0) ** 2])
 
 LASER_MODELS = ('likelihood_field',)
+REFINE_SIGMA = 0.05      # m: the walls' field of the refinement (gmapping's sigma on TurtleBot3)
+REFINE_ITERATIONS = 5    # Gauss-Newton steps
+REFINE_PRIOR = 20.0      # beams' worth of pull towards the cluster's mean
+REFINE_LIMIT = (0.1, 0.1)  # m, rad: a match moving the mean further is not taken
+REFINE_SHARE = 0.5       # of the beams that must score on walls
 ODOM_MODELS = ('diff', 'diff-corrected')
 
 
@@ -121,6 +139,8 @@ class AmclConfig(object):
     global_frame_id: str = _p('map', _frame_id, "the map's frame")
     tf_broadcast: bool = _p(True, lambda value: None if isinstance(value, bool) else 'must be true or false',
                             'publish map -> odom')
+    refine_estimate: bool = _p(True, lambda value: None if isinstance(value, bool) else 'must be true or false',
+                               "ours: the estimate matched to the map by the scan (see Amcl); false: amcl's mean")
 
     def __post_init__(self):
         for field in dataclasses.fields(self):
@@ -181,6 +201,10 @@ class Amcl(object):
         self.grid = grid
         self.field = LikelihoodField(grid, values, config.laser_likelihood_max_dist)
         self.model = LikelihoodFieldModel(self.field, config.laser_z_hit, config.laser_z_rand, config.laser_sigma_hit)
+        occupied = np.asarray(values).reshape(grid.shape) == 100
+        self._walls = (matcher.WallField(grid, occupied, REFINE_SIGMA, matcher.line_means(grid, occupied))
+                       if config.refine_estimate and occupied.any() else None)
+        self._points = None  # the last update's beam end points (base frame), for the refinement
         free = np.argwhere(np.asarray(values).reshape(grid.shape) == 0)  # amcl samples free cells only, not unknown
         self._free_cells = free[:, ::-1]  # (ix, iy)
         self._rng = np.random.default_rng(seed)
@@ -200,6 +224,7 @@ class Amcl(object):
         return self._weights
 
     def _reset(self, poses):
+        self._points = None  # a scan from before is no evidence for the new cloud
         self._poses = poses
         self._weights = np.full(len(poses), 1.0 / len(poses))
         self._odom = None  # the next scan updates the filter, moved or not (amcl's pf_init_ false)
@@ -279,6 +304,7 @@ class Amcl(object):
 
     def _weigh(self, scan, sensor_pose):
         points, range_max = self._beams(scan, sensor_pose)
+        self._points = points
         weights = self._weights * self.model.weights(self._poses, points, range_max)
         total = float(weights.sum())
         self._weights = weights / total
@@ -307,8 +333,20 @@ class Amcl(object):
         members = labels == heaviest
         cluster = pf.stats(self._poses[members], self._weights[members])
         whole = pf.stats(self._poses, self._weights)
-        return Estimate(tuple(float(value) for value in cluster.mean), whole.covariance, cluster.covariance,
-                        float(cluster.weight), int(count))
+        return Estimate(self._refined(tuple(float(value) for value in cluster.mean)), whole.covariance,
+                        cluster.covariance, float(cluster.weight), int(count))
+
+    def _refined(self, mean):
+        """The mean matched to the map by the last update's scan, if the match holds (see the module)."""
+        points = self._points
+        if self._walls is None or points is None or len(points) < 10:
+            return mean
+        pose, score = matcher.refine(self._walls, points, mean, REFINE_ITERATIONS, prior=mean,
+                                     prior_weight=REFINE_PRIOR)
+        if score < REFINE_SHARE * len(points) or math.hypot(pose[0] - mean[0], pose[1] - mean[1]) > REFINE_LIMIT[0] \
+                or abs(normalize_angle(pose[2] - mean[2])) > REFINE_LIMIT[1]:
+            return mean
+        return tuple(float(value) for value in pose)
 
     def estimate(self):
         """amcl's Estimate of the current set."""

@@ -239,3 +239,34 @@ def _pairing(points):
     cell[~line] = CORNER_WEIGHT * np.eye(2)
     pairing[rows, cols] = cell
     return pairing
+
+
+def line_means(grid, occupied, radius=3, flatness=0.1):
+    """Wall points for a map that keeps no hits (one loaded from a file): each occupied cell's
+    centre put on the line fitted (principal axis) through the occupied cells' centres within
+    `radius` cells of it, where those lie along a line (spread across below `flatness` of the
+    spread along); else the centre. Centres alone are up to half a cell off the surface each, and
+    a scan matched to them was 2 cm off the truth (median; a map made from the simulated lidar,
+    saved as map_saver saves it); to the fitted lines 0.9 cm (radius 3, 2026-11-23)."""
+    size = np.arange(-radius, radius + 1)
+    kernel = (np.hypot(*np.meshgrid(size, size)) <= radius).astype(float)
+    centres = grid.all_centres()
+    weight = occupied.astype(float)
+
+    def local(values):
+        return ndimage.convolve(weight * values, kernel, mode='constant')
+    count = np.maximum(local(np.ones(grid.shape)), 1.0)
+    x, y = centres[..., 0], centres[..., 1]
+    mean_x, mean_y = local(x) / count, local(y) / count
+    sxx, syy = local(x * x) / count - mean_x ** 2, local(y * y) / count - mean_y ** 2
+    sxy = local(x * y) / count - mean_x * mean_y
+    angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
+    half_sum, root = 0.5 * (sxx + syy), np.sqrt(0.25 * (sxx - syy) ** 2 + sxy ** 2)
+    along_x, along_y = np.cos(angle), np.sin(angle)
+    reach = (x - mean_x) * along_x + (y - mean_y) * along_y
+    on_line = np.stack((mean_x + reach * along_x, mean_y + reach * along_y), axis=-1)
+    line = occupied & (half_sum - root < flatness * (half_sum + root))
+    means = np.full(grid.shape + (2,), np.nan)
+    means[occupied] = centres[occupied]
+    means[line] = on_line[line]
+    return means
