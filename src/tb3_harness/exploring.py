@@ -129,3 +129,48 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
     return ExplorationRun(world, factor, match.group(2), int(match.group(6)), int(match.group(8)),
                           float(match.group(7)), wall, truth, map_name + '.yaml', quality,
                           clearance(truth, obstacles, BURGER_FOOTPRINT), saved.grid, saved.values)
+
+
+#: The worlds explored from their launch's spawn pose: launch, spawn (x, y).
+WORLDS = {'turtlebot3_world': ('tb3_world.launch', (-2.0, -0.5)),
+          'turtlebot3_house': ('tb3_house.launch', (-3.0, 1.0))}
+
+
+def draw(run, filename):
+    """The saved map under the world's outline, with the true path."""
+    import rospkg
+    from tb3_sim_nav.world_file import load_world
+    from .map_quality import render_png
+    worlds = os.path.join(rospkg.RosPack().get_path('tb3_sim_nav'), 'worlds')
+    render_png(filename, run.grid, run.values, load_world(run.world, worlds).obstacles,
+               paths={'true path': [p[1:3] for p in run.truth]},
+               title='%s explored alone: %.0f %% of the reachable free floor mapped, %.0f s of sim time, %d goals'
+                     % (run.world, 100 * run.quality.free_floor_mapped, run.sim_seconds, run.goals))
+
+
+def main(argv=None):
+    """python3 -m tb3_harness.exploring WORLD --out DIR: one exploration against a master of
+    its own (profile realistic, as fast as possible), its figures, and DIR/exploration.png."""
+    import argparse
+    from .processes import start_master
+    parser = argparse.ArgumentParser(description=main.__doc__.split('\n')[0])
+    parser.add_argument('world', choices=sorted(WORLDS))
+    parser.add_argument('--out', required=True, help='a folder for the logs, the map and the picture')
+    parser.add_argument('--timeout', type=float, default=3600.0, help='wall s for the exploration')
+    args = parser.parse_args(argv)
+    os.makedirs(args.out, exist_ok=True)
+    os.environ.setdefault('TURTLEBOT3_MODEL', 'burger')
+    launch, start = WORLDS[args.world]
+    master = start_master(args.out)
+    try:
+        run = explore_world(args.out, args.out, world=args.world, launch=launch, start=start, timeout=args.timeout)
+    finally:
+        master.stop()
+    draw(run, os.path.join(args.out, 'exploration.png'))
+    print(run.summary())
+    return 0
+
+
+if __name__ == '__main__':
+    import sys
+    sys.exit(main())

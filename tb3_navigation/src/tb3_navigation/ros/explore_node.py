@@ -63,7 +63,10 @@ class ExploreNode(object):
         self._results = queue.Queue()  # (sim time, goal, state) of the goals move_base ended
         self._markers = 0
         self.started = None      # sim time of the first decision: the exploration's start
-        self.client = actionlib.SimpleActionClient('move_base', MoveBaseAction)
+        # actionlib's plain client: the simple one logs an error for every status of a goal it
+        # replaced (a new goal every few seconds here); the Explorer ignores those anyway.
+        self.client = actionlib.ActionClient('move_base', MoveBaseAction)
+        self._handle = None      # the current goal's handle (kept, or its callbacks stop)
         self.marker_pub = rospy.Publisher('~frontiers', MarkerArray, queue_size=1, latch=True) \
             if self.visualize else None
         rospy.Subscriber(self.topic, OccupancyGrid, self._on_map, queue_size=1)
@@ -73,10 +76,11 @@ class ExploreNode(object):
         with self._map_lock:
             self._map = (grid, values, message.header.frame_id.lstrip('/'), message.header.stamp.to_sec())
 
-    def _on_done(self, goal):
-        def done(state, _result):
-            self._results.put((rospy.get_time(), goal, state))
-        return done
+    def _on_transition(self, goal):
+        def transition(handle):
+            if handle.get_comm_state() == actionlib.CommState.DONE:
+                self._results.put((rospy.get_time(), goal, handle.get_goal_status()))
+        return transition
 
     # --- the loop -------------------------------------------------------------------------
     def wait_for_move_base(self, life):
@@ -157,7 +161,7 @@ class ExploreNode(object):
         goal.target_pose.pose.position.x, goal.target_pose.pose.position.y = x, y
         q = goal.target_pose.pose.orientation
         q.x, q.y, q.z, q.w = quaternion_of_yaw(yaw)
-        self.client.send_goal(goal, done_cb=self._on_done(decision.goal))
+        self._handle = self.client.send_goal(goal, transition_cb=self._on_transition(decision.goal))
         frontier = decision.frontier
         free, occupied, known = explored_area(grid, values)
         rospy.loginfo('%s: [%.1f s] goal %d (%.2f, %.2f): frontier of %.2f m, %.2f m away, cost %.2f; %d candidates; '
