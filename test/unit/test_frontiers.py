@@ -278,9 +278,19 @@ def test_a_reached_goal_waits_for_a_newer_map_and_is_not_visited_twice():
     explorer.result(6.0, goal, SUCCEEDED)
     at_goal = (goal[0], goal[1], 0.0)
     assert explorer.decide(6.0, grid, values, at_goal, map_time=5.0).action == WAIT
+    assert explorer.decide(10.9, grid, values, at_goal, map_time=5.0).action == WAIT
     again = explorer.decide(8.0, grid, values, at_goal, map_time=7.0)  # still a frontier there
     assert explorer.blacklist == [goal[:2]] and 'reached' in explorer.take_notes()[0]
     assert again.action == SEND and math.hypot(again.goal[0] - goal[0], again.goal[1] - goal[1]) > 0.25
+
+
+def test_no_newer_map_waits_5_s_at_most():
+    grid, values = room(3.0, 1.0, unknown_from=1.5)
+    explorer = Explorer()
+    goal = explorer.decide(0.0, grid, values, (0.25, 0.5, 0.0), map_time=0.0).goal
+    explorer.result(6.0, goal, SUCCEEDED)
+    assert explorer.decide(10.9, grid, values, goal, map_time=0.0).action == WAIT
+    assert explorer.decide(11.1, grid, values, goal, map_time=0.0).action == SEND
 
 
 def test_done_is_for_good():

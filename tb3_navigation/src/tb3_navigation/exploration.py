@@ -13,9 +13,9 @@ pursues, WAIT, or DONE with the reason. As explore_lite:
 - when no frontier is left worth visiting, exploration is DONE, for good.
 
 Two additions, each closing a way to sit still: after a goal SUCCEEDS the
-decision WAITs for a map made after it (the SLAM publishes every
-map_update_interval, 2 s: the map of the moment still shows the frontier the
-robot just went to look at); and a target within blacklist_radius of the goal
+decision WAITs for a map made after it, MAP_WAIT s at most (the SLAM
+publishes every map_update_interval, 2 s: the map of the moment still shows
+the frontier the robot just went to look at); and a target within blacklist_radius of the goal
 just reached, on that newer map, is blacklisted at once (the robot stood
 there and saw all it could: explore_lite would sit there for progress_timeout,
 30 s, first).
@@ -28,6 +28,7 @@ from .costmap import CostmapConfig
 from .planner import PlannerConfig
 
 SEND, KEEP, WAIT, DONE = 'send', 'keep', 'wait', 'done'
+MAP_WAIT = 5.0  # s: the longest wait for a map newer than a goal's success (the SLAM's come every 2 s)
 SUCCEEDED, ABORTED = 3, 4  # actionlib_msgs/GoalStatus
 
 
@@ -81,7 +82,8 @@ class Explorer(object):
         `map_time`, if known) for the robot at `robot_pose` (x, y, yaw) in the map's frame."""
         if self.done:
             return Decision(DONE, text=self.done_text)
-        if self._reached is not None and map_time is not None and map_time <= self._reached_at:
+        if self._reached is not None and map_time is not None and map_time <= self._reached_at \
+                and now < self._reached_at + MAP_WAIT:
             return Decision(WAIT, text='waiting for a map made after the goal was reached')
         config, resolution = self.config, grid.resolution
         while True:  # each pass either decides or blacklists one more point: it ends
