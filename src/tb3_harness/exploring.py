@@ -7,7 +7,8 @@ explore:=true open_rviz:=false`, waits until the explore node says
 "exploration done", then `rosrun map_server map_saver -f DIR/map`, and
 stops both launches with Ctrl+C. A recorder (tb3_harness.pose_recorder)
 keeps the true path meanwhile. It then measures the saved map against the
-world file (tb3_harness.map_quality) and the footprint's least distance to
+world file (tb3_harness.map_quality; the free floor within the world's own
+box, not the yard round turtlebot3_house that the SLAM's map also holds) and the footprint's least distance to
 the world along the true path (tb3_harness.navigating.clearance). No rospy
 in this process.
 """
@@ -77,6 +78,7 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
     import rosgraph
     import rospkg
     from tb3_navigation.map_files import load_map
+    from tb3_sim_nav import world_map
     from tb3_sim_nav.world_file import load_world
     master_uri = os.environ['ROS_MASTER_URI']
     if master_pid(master_uri) is None:
@@ -125,7 +127,8 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
     saved = load_map(map_name + '.yaml')
     worlds = os.path.join(rospkg.RosPack().get_path('tb3_sim_nav'), 'worlds')
     obstacles = load_world(world, worlds).obstacles
-    quality = measure(saved.grid, saved.values, obstacles, start[:2])
+    quality = measure(saved.grid, saved.values, obstacles, start[:2],
+                      bounds=world_map.bounds(world_map.in_plane(obstacles)))
     return ExplorationRun(world, factor, match.group(2), int(match.group(6)), int(match.group(8)),
                           float(match.group(7)), wall, truth, map_name + '.yaml', quality,
                           clearance(truth, obstacles, BURGER_FOOTPRINT), saved.grid, saved.values)

@@ -10,8 +10,8 @@ from scipy import ndimage
 
 from tb3_navigation.costmap import Costmap, CostmapConfig
 from tb3_navigation.exploration import ABORTED, DONE, KEEP, SEND, SUCCEEDED, WAIT, Explorer
-from tb3_navigation.frontiers import (BLACKLISTED, CANDIDATE, NO_ROOM, TOO_SMALL, UNREACHABLE, ExploreConfig,
-                                      FrontierSearch, explored_area, frontier_cells, label_frontiers)
+from tb3_navigation.frontiers import (BLACKLISTED, CANDIDATE, IN_THE_OPEN, NO_ROOM, TOO_SMALL, UNREACHABLE,
+                                      ExploreConfig, FrontierSearch, explored_area, frontier_cells, label_frontiers)
 from tb3_navigation.grid import Grid
 from tb3_navigation.occupancy import OccupancyGrid
 from tb3_navigation.planner import GlobalPlanner, plan_length
@@ -197,6 +197,22 @@ def test_a_frontier_where_the_robot_does_not_fit_and_a_small_one_are_not_chosen(
     assert smaller.best is not None and smaller.best.size == pytest.approx(0.4)
 
 
+def test_a_frontier_far_from_every_wall_is_in_the_open():
+    """A 12 x 3 m corridor walled only on its west end and its sides for the first 4 m, seen up
+    to 8 m east: its frontier at x = 8 m is 4 m from the last wall (more than max_wall_distance,
+    2.5 m), so the robot is not sent out where the lidar would see no wall. With the limit
+    at 0 (none) it is a candidate; a wall seen near it makes it one too."""
+    grid, values = room(12.0, 3.0, unknown_from=8.0)
+    values[[0, -1], 81:] = 0  # no side walls east of x = 4 m
+    values[[0, -1], 161:] = -1
+    search = FrontierSearch().search(grid, values, (1.0, 1.5, 0.0))
+    assert [frontier.status for frontier in search.frontiers if frontier.size > 1.0] == [IN_THE_OPEN]
+    assert 'in the open' in search.why_none()
+    assert FrontierSearch(ExploreConfig(max_wall_distance=0.0)).search(grid, values, (1.0, 1.5, 0.0)).best
+    values[-1, 140:150] = 100  # a piece of wall seen 1 m before the frontier
+    assert FrontierSearch().search(grid, values, (1.0, 1.5, 0.0)).best is not None
+
+
 def test_the_blacklist_rules_out_goals_within_its_radius():
     grid, values = room(3.0, 1.0, unknown_from=1.5)
     search = FrontierSearch()
@@ -227,7 +243,7 @@ def test_explored_area():
 
 def test_config_checks_name_the_parameter():
     for name, value in (('planner_frequency', 0.0), ('progress_timeout', -1.0), ('gain_scale', float('nan')),
-                        ('min_frontier_size', True)):
+                        ('min_frontier_size', True), ('max_wall_distance', -0.1)):
         with pytest.raises(ValueError, match=name):
             ExploreConfig(**{name: value})
 

@@ -39,8 +39,19 @@ A frontier smaller than min_frontier_size (m) is not worth visiting; one
 with no cell where the footprint fits has no room (a wall the map shows
 with gaps, seen at a grazing angle, borders unknown space all along); one
 whose roomy cells no plan reaches is unreachable; one whose reachable cells
-all lie within blacklist_radius of a blacklisted goal is blacklisted. The
-rest are candidates, cheapest first; none left: exploration is done.
+all lie farther than max_wall_distance from every wall of the map is in the
+open; one whose remaining cells all lie within blacklist_radius of a
+blacklisted goal is blacklisted. The rest are candidates, cheapest first;
+none left: exploration is done.
+
+max_wall_distance is not explore_lite's. The SLAM keeps its pose by
+matching walls within maxUrange (3.0 m); on open ground it runs on
+odometry alone. turtlebot3_house is open to its yard, and the SLAM's map
+reaches 10 m out: without the limit the robot went out to the map's edge,
+the pose in the map drifted 0.25 m, then 2.5 m, off the truth and the map
+doubled its walls (measured: occupied cells near a real surface fell to
+50 %). A goal within 2.5 m of a known wall keeps one within the lidar's
+reach from there.
 """
 import math
 from dataclasses import dataclass
@@ -48,13 +59,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from .costmap import INSCRIBED_INFLATED_OBSTACLE, Costmap, CostmapConfig, inflation_costs
+from .costmap import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE, Costmap, CostmapConfig, inflation_costs
 from .grid import Grid
 from .grid_graph import path_to
 from .planner import GlobalPlanner, PlannerConfig
 
-CANDIDATE, TOO_SMALL, NO_ROOM, UNREACHABLE, BLACKLISTED = ('candidate', 'too small', 'no room', 'unreachable',
-                                                           'blacklisted')
+CANDIDATE, TOO_SMALL, NO_ROOM, UNREACHABLE, IN_THE_OPEN, BLACKLISTED = (
+    'candidate', 'too small', 'no room', 'unreachable', 'in the open', 'blacklisted')
 FOUR = ndimage.generate_binary_structure(2, 1)
 EIGHT = ndimage.generate_binary_structure(2, 2)
 HEADING_BACK = 0.3  # m: the goal faces the way the path comes in over its last 0.3 m
@@ -64,7 +75,8 @@ WINDOW_MARGIN = 0.5  # m: of unknown space kept around the known part, beyond th
 @dataclass(frozen=True)
 class ExploreConfig:
     """explore_lite's parameters, with explore_lite's explore.launch values (TurtleBot3 has none
-    of its own); blacklist_radius is this rule's (explore_lite: a square of +-5 cells)."""
+    of its own); blacklist_radius (explore_lite: a square of +-5 cells) and max_wall_distance (0:
+    no limit) are this rule's."""
     planner_frequency: float = 0.33
     progress_timeout: float = 30.0
     potential_scale: float = 3.0
@@ -72,10 +84,11 @@ class ExploreConfig:
     gain_scale: float = 1.0
     min_frontier_size: float = 0.5
     blacklist_radius: float = 0.25
+    max_wall_distance: float = 2.5
 
     def __post_init__(self):
         for name in ('planner_frequency', 'progress_timeout', 'potential_scale', 'orientation_scale', 'gain_scale',
-                     'min_frontier_size', 'blacklist_radius'):
+                     'min_frontier_size', 'blacklist_radius', 'max_wall_distance'):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
                     or value < 0:
@@ -87,7 +100,7 @@ class ExploreConfig:
 @dataclass(frozen=True)
 class Frontier:
     """One frontier: its cells' centres (n, 2), size (m), centroid (x, y), status (CANDIDATE,
-    TOO_SMALL, UNREACHABLE, BLACKLISTED); for a candidate its goal (x, y, yaw), the path's
+    NO_ROOM, UNREACHABLE, IN_THE_OPEN, BLACKLISTED); for a candidate its goal (x, y, yaw), the path's
     distance (m) to it, the turn (rad) towards it and its cost (inf for the others)."""
     points: np.ndarray
     size: float
@@ -123,6 +136,7 @@ class Search:
             return 'no frontier left: the map is closed (no free cell borders unknown space)'
         parts = []
         for status, words in ((UNREACHABLE, 'out of the planner\'s reach'), (BLACKLISTED, 'blacklisted'),
+                              (IN_THE_OPEN, 'in the open, farther than max_wall_distance from any wall'),
                               (NO_ROOM, 'with no cell where the robot fits'),
                               (TOO_SMALL, 'smaller than min_frontier_size')):
             frontiers = [frontier for frontier in self.frontiers if frontier.status == status]
@@ -163,6 +177,16 @@ class FrontierSearch(object):
                                self.costmap_config.inflation_radius, self.costmap_config.cost_scaling_factor)
         return min(int(cost), INSCRIBED_INFLATED_OBSTACLE - 1)
 
+    def near_walls(self, costmap):
+        """True (H, W) within max_wall_distance of a lethal cell (everywhere if it is 0)."""
+        if not self.config.max_wall_distance:
+            return np.ones(costmap.grid.shape, dtype=bool)
+        walls = costmap.costs == LETHAL_OBSTACLE
+        if not walls.any():
+            return np.zeros(costmap.grid.shape, dtype=bool)
+        distance = ndimage.distance_transform_edt(~walls) * costmap.grid.resolution
+        return distance <= self.config.max_wall_distance
+
     def search(self, grid, values, robot_pose, blacklist=()):
         """The Search of the map `values` [iy, ix] on `grid` for a robot at `robot_pose` (x, y, yaw),
         goals within blacklist_radius of a point of `blacklist` [(x, y)] ruled out."""
@@ -177,6 +201,7 @@ class FrontierSearch(object):
         else:
             potential, predecessors = spread
         costs, room = costmap.costs, self.admissible_cost(costmap)
+        walled = self.near_walls(costmap)
         blacklist = np.asarray(blacklist, dtype=float).reshape(-1, 2)
         frontiers = []
         for index, rows_cols in enumerate(ndimage.find_objects(labels), start=1):
@@ -191,10 +216,12 @@ class FrontierSearch(object):
                 continue
             roomy = costs[cells[:, 1], cells[:, 0]] <= room
             reachable = roomy & np.isfinite(potential[cells[:, 1], cells[:, 0]])
-            allowed = reachable & _away_from(points, blacklist, config.blacklist_radius)
+            in_view = reachable & walled[cells[:, 1], cells[:, 0]]
+            allowed = in_view & _away_from(points, blacklist, config.blacklist_radius)
             open_cells = cells[allowed]
             if not len(open_cells):
-                status = BLACKLISTED if reachable.any() else UNREACHABLE if roomy.any() else NO_ROOM
+                status = (BLACKLISTED if in_view.any() else IN_THE_OPEN if reachable.any() else
+                          UNREACHABLE if roomy.any() else NO_ROOM)
                 frontiers.append(Frontier(points, size, centroid, status))
                 continue
             best = open_cells[np.argmin(potential[open_cells[:, 1], open_cells[:, 0]])]
