@@ -19,7 +19,10 @@ occupied >= 65, free 0..25, anything else (and -1) unknown.
   other real surface: a wall mapped twice (a jump in the pose).
 - free_floor_mapped: the share of the reachable free floor mapped as free;
   reachable: the cells whose centre is more than the robot's radius (Burger
-  0.105 m) from any obstacle, connected to the start. For exploration.
+  0.105 m) from any obstacle, connected to the start, and within `bounds`
+  if given (the world's own box: turtlebot3_house is open to a yard that
+  the SLAM's 20 x 20 m map holds too, and the house is what is explored).
+  For exploration.
 """
 import dataclasses
 import math
@@ -138,9 +141,10 @@ def _walls_along_normals(grid, occupied, truth_clearance, points, normals, confi
     return thickness, doubled
 
 
-def measure(grid, values, obstacles, start, config=QualityConfig()):
+def measure(grid, values, obstacles, start, config=QualityConfig(), bounds=None):
     """The MapQuality of int8 `values` [iy, ix] on `grid` (tb3_navigation.grid.Grid) against the world's
-    `obstacles` (world_file.Obstacle), the robot having started at `start` (x, y) in the reachable space."""
+    `obstacles` (world_file.Obstacle), the robot having started at `start` (x, y) in the reachable space;
+    the reachable floor within `bounds` (xmin, ymin, xmax, ymax) if given."""
     values = np.asarray(values)
     if values.shape != grid.shape:
         raise ValueError('values of shape %r on a grid of shape %r' % (values.shape, grid.shape))
@@ -169,6 +173,10 @@ def measure(grid, values, obstacles, start, config=QualityConfig()):
 
     clearance = signed_distance(cut, centres.reshape(-1, 2)).reshape(grid.shape)
     reachable = _component(clearance > config.robot_radius, grid, start, 'reachable floor')
+    if bounds is not None:
+        xmin, ymin, xmax, ymax = bounds
+        reachable &= ((centres[..., 0] >= xmin) & (centres[..., 0] <= xmax) & (centres[..., 1] >= ymin)
+                      & (centres[..., 1] <= ymax))
     return MapQuality(
         occupied_near_surface=_share(near), surface_covered=_share(covered),
         wall_thickness=float(np.median(thickness[measured])) if measured.any() else math.nan,

@@ -62,11 +62,13 @@ class Lidar(object):
         self.angles = np.arange(BEAMS) * 2.0 * math.pi / BEAMS
 
     def scan(self, pose):
-        """The Scan seen from the robot at `pose` (x, y, yaw, world frame): inf beyond range."""
+        """The Scan seen from the robot at `pose` (x, y, yaw, world frame)."""
         sensor = compose(pose, SCAN_POSE)
         ranges = world_map.ray_cast(self.obstacles, sensor[:2], sensor[2] + self.angles)
         ranges = ranges + self.rng.normal(0.0, SIGMA, BEAMS)
-        ranges = np.where((ranges >= RANGE_MIN) & (ranges <= RANGE_MAX), ranges, np.inf)
+        # As the simulator's lidar (REP 117): +inf past range_max, -inf nearer than range_min
+        # (a reading the cores skip: a +inf there would clear the cells through the obstacle).
+        ranges = np.where(ranges > RANGE_MAX, np.inf, np.where(ranges < RANGE_MIN, -np.inf, ranges))
         return Scan(0.0, 2.0 * math.pi / BEAMS, ranges, RANGE_MIN, RANGE_MAX)
 
 

@@ -188,3 +188,17 @@ def test_the_png_shows_the_map_the_outline_and_the_paths(world, perfect, tmp_pat
     red = (drawn[..., 0] > 150) & (drawn[..., 1] < 100) & (drawn[..., 2] < 100)  # the outline
     blue = (drawn[..., 2] > 150) & (drawn[..., 0] < 100)  # the path
     assert red.sum() > 1000 and blue.sum() > 500
+
+
+def test_bounds_keep_the_free_floor_measure_to_a_box(world, perfect):
+    """The floor outside `bounds` does not count: the east half of the map known, the west half
+    not, measured in the east half only the floor is all mapped."""
+    grid, values = perfect
+    west = grid.all_centres()[..., 0] < 0.0
+    half = np.where(west, -1, values).astype(np.int8)
+    whole = measure(grid, half, world, (1.65, -0.55))
+    east = measure(grid, half, world, (1.65, -0.55), bounds=(0.0, -5.0, 5.0, 5.0))
+    print('MEASURED the east half mapped: free floor %.3f of the whole, %.3f of the east half'
+          % (whole.free_floor_mapped, east.free_floor_mapped))
+    assert 0.4 < whole.free_floor_mapped < 0.6
+    assert east.free_floor_mapped == 1.0 and east.reachable_cells < 0.6 * whole.reachable_cells

@@ -109,6 +109,25 @@ def test_the_plan_is_the_cheapest_path_the_potential_knows(world):
     assert best[target] == pytest.approx(cost)
 
 
+def test_spread_gives_every_cell_s_plan_cost_in_one_search(world):
+    """spread: the potential of the whole costmap from the robot, the same at each goal as the
+    plan's own search; inf inside pillars and outside the walls; None from off the map."""
+    obstacles, costmap = world
+    start = (-2.0, -0.5, 0.0)
+    potential, predecessors = GlobalPlanner().spread(costmap, start)
+    grid = costmap.grid
+    for goal in free_points(obstacles, 6, seed=9):
+        planner = GlobalPlanner()
+        assert planner.make_plan(costmap, start, (goal[0], goal[1], 0.0)) is not None
+        cell = grid.to_cells(goal)
+        assert potential[cell[1], cell[0]] == pytest.approx(planner.potential[cell[1], cell[0]])
+    for point in ((0.0, 0.0), (0.0, 2.9), (2.8, 0.0)):  # the centre pillar; beyond the north and east walls
+        cell = grid.to_cells(np.array(point))
+        assert np.isinf(potential[cell[1], cell[0]])
+    assert predecessors.shape == grid.shape
+    assert GlobalPlanner().spread(costmap, (9.0, 0.0)) is None
+
+
 def test_no_plan_into_a_pillar_off_the_map_or_from_off_the_map(world):
     _, costmap = world
     planner = GlobalPlanner()

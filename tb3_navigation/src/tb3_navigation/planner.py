@@ -90,6 +90,27 @@ class GlobalPlanner(object):
         middle = grid.centres(np.stack((cells % grid.width, cells // grid.width), axis=-1)).reshape(-1, 2)
         return orient([tuple(start[:2])] + [tuple(point) for point in middle] + [end], goal[2])
 
+    def spread(self, costmap, start):
+        """navfn's computePotential from the robot at `start` (x, y) over the whole costmap:
+        (potential, predecessors), each (H, W), the cheapest path's cost from the robot's
+        cell to every cell (inf where no plan reaches) and the cell each path came from
+        (grid_graph.UNREACHED for the robot's cell and unreached ones); None if `start`
+        is off the map. One search answers "can a plan reach it, and how long is it"
+        for every cell at once (frontier exploration asks it of every frontier)."""
+        grid = costmap.grid
+        if not np.all(np.isfinite(np.asarray(start, dtype=float)[:2])):
+            return None
+        start_cell = grid.to_cells(np.asarray(start[:2], dtype=float))
+        if not grid.inside(start_cell):
+            return None
+        self._use(costmap.costs)
+        if None not in self._graphs:
+            self._graphs[None] = build(self._steps)
+        distances, predecessors = shortest_paths(self._graphs[None], grid.shape,
+                                                 [int(start_cell[1] * grid.width + start_cell[0])])
+        self.potential = distances
+        return distances, predecessors
+
     def _use(self, costs):
         """Step costs and graph of `costs`, kept while they stay the same (most updates of a
         global costmap change nothing: the same walls seen again)."""
