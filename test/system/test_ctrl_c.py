@@ -59,10 +59,15 @@ def start_world(processes, factor, tag):
     return processes.start('roslaunch_%s' % tag, LAUNCH + ['real_time_factor:=%g' % factor], env=env)
 
 
-def suspended_reader(processes, tag):
-    """`rostopic echo /scan`, stopped (as Ctrl+Z) once it has printed a scan."""
-    reader = processes.start('echo_%s' % tag, ['rostopic', 'echo', '/scan'],
-                             env=dict(os.environ, PYTHONUNBUFFERED='1', **{leftovers.TAG: tag}))
+def scan_reader(processes, tag):
+    """`rostopic echo /scan`, started beside the launch (their start-ups overlap:
+    each takes 2-4 wall s of python on a busy machine); see suspend."""
+    return processes.start('echo_%s' % tag, ['rostopic', 'echo', '/scan'],
+                           env=dict(os.environ, PYTHONUNBUFFERED='1', **{leftovers.TAG: tag}))
+
+
+def suspend(reader):
+    """The reader stopped (as Ctrl+Z) once it has printed a scan."""
     assert wait_until(lambda: 'ranges' in reader.output(1 << 22), READY_TIMEOUT, poll=0.05), reader.describe()
     reader.signal_group(signal.SIGSTOP)
     return reader
@@ -78,8 +83,9 @@ def test_ctrl_c_ends_the_simulator_within_2_s_every_time(ros_port, processes):
         factor = (0.0, 1.0)[press % 2]
         tag = 'ctrl_c_%d' % press
         launch = start_world(processes, factor, tag)
+        reader = scan_reader(processes, tag)
         simulator = simulator_of(launch)
-        reader = suspended_reader(processes, tag)
+        suspend(reader)
         time.sleep(rng.uniform(0.0, 3.0))
         assert alive(simulator), launch.describe()
         os.kill(launch.pid, signal.SIGINT)  # as the terminal's Ctrl+C: to roslaunch alone
@@ -129,8 +135,9 @@ def test_every_other_way_to_end_the_simulator_takes_under_2_s(how, ros_port, pro
         processes.start('hz%s' % topic.replace('/', '_'), ['rostopic', 'hz', topic])
     tag = how.replace(' ', '_').replace('+', '')
     launch = start_world(processes, 0.0, tag)
+    reader = scan_reader(processes, tag)
     simulator = simulator_of(launch)
-    reader = suspended_reader(processes, tag)
+    suspend(reader)
     if how == 'Ctrl+C while paused':
         assert run(['rosservice', 'call', '/gazebo/pause_physics'], 30.0).returncode == 0
     time.sleep(1.0)
