@@ -46,6 +46,18 @@ def children(pid):
     return found
 
 
+def registered(node, pid):
+    """True once process `pid` has registered as `node` with the master."""
+    import xmlrpc.client
+
+    import rosgraph
+    try:
+        uri = rosgraph.Master('/tb3_ctrl_c_test').lookupNode(node)
+        return xmlrpc.client.ServerProxy(uri).getPid('/tb3_ctrl_c_test')[2] == pid
+    except Exception:  # not (yet) registered, an earlier one's gone, no master
+        return False
+
+
 def simulator_of(launch):
     """The pid of the launch's tb3_sim_node, once started."""
     found = wait_until(lambda: [pid for pid, command in children(launch.pid).items() if 'tb3_sim_node' in command],
@@ -111,8 +123,10 @@ def test_the_simulator_ends_when_roslaunch_is_killed(ros_port, processes):
         tag = 'kill_%g' % factor
         launch = start_world(processes, factor, tag)
         simulator = simulator_of(launch)
-        assert wait_until(lambda: 'started core service' in launch.output() or 'tb3_sim' in launch.output(),
-                          READY_TIMEOUT)
+        # Registered: its parent watch runs. (roslaunch's own line naming tb3_sim comes
+        # when it forks the node; killed before the node has even imported rospy, 4 s
+        # later on a busy machine, the node would find no roslaunch to watch.)
+        assert wait_until(lambda: registered('/tb3_sim', simulator), READY_TIMEOUT), launch.describe()
         time.sleep(2.0)
         os.kill(launch.pid, signal.SIGKILL)
         killed = time.monotonic()
