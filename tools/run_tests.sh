@@ -66,7 +66,8 @@ part 2 test_calibration.busy_core "$pytest test/system/test_calibration.py -k bu
 part 1 test_teleop "$pytest test/system/test_teleop.py"
 # A Waffle Pi's camera rendered and shown in rviz: a core's worth.
 part 2 test_readme_walkthrough.camera "$pytest test/system/test_readme_walkthrough.py -k camera"
-part 1 test_readme_walkthrough "$pytest test/system/test_readme_walkthrough.py -k 'not make_demo and not tutorial_command and not camera'"
+part 1 test_readme_walkthrough \
+  "$pytest test/system/test_readme_walkthrough.py -k 'not make_demo and not tutorial_command and not camera'"
 part 1 test_speed_agreement.nav_square "$pytest test/system/test_speed_agreement.py -k nav_square"
 part 1 test_speed_agreement.odom_out_and_back "$pytest test/system/test_speed_agreement.py -k odom_out_and_back"
 part 1 test_speed_agreement "$pytest test/system/test_speed_agreement.py -k 'not nav_square and not odom_out_and_back'"
