@@ -9,22 +9,28 @@
 # Each part's output is shown whole when it ends; at the end come a table of
 # what each took and the lines that say why a part failed.
 #
-#   bash tools/run_tests.sh [--integration-only] [PART ...]   # PART: run only these (names as in the table)
+#   bash tools/run_tests.sh [--plan] [--integration-only] [PART ...]
+#
+# --plan prints the plan instead of running it; PART names (as in the table)
+# run only those parts.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 export ROS_HOSTNAME=localhost
 unset ROS_IP
 logs=$(mktemp -d)
 plan=$logs/plan
-integration_only=
+integration_only= plan_only=
+if [ "${1:-}" = --plan ]; then plan_only=yes; shift; fi
 if [ "${1:-}" = --integration-only ]; then integration_only=yes; shift; fi
 only=" $* "
 pytest='python3 -m pytest -q -p no:cacheprovider'
-# part SLOTS NAME COMMAND...: a line of the plan, unless PART names were given and NAME is not one.
+# part SLOTS NAME COMMAND...: a line of the plan (a command's line breaks become
+# spaces), unless PART names were given and NAME is not one.
 planned=" "
 part() {
   planned+="$2 "
-  if [ "$only" = "  " ] || [[ "$only" == *" $2 "* ]]; then echo "$*" >> "$plan"; fi
+  local line="$*"
+  if [ "$only" = "  " ] || [[ "$only" == *" $2 "* ]]; then echo "${line//$'\n'/ }" >> "$plan"; fi
 }
 
 # catkin_lint of the packages as the workspace holds them: its folder named as the package.
@@ -90,6 +96,7 @@ if [ -z "$integration_only" ]; then
   part 2 soak "timeout --signal=INT --kill-after=20 600 python3 tools/soak.py --sim-seconds 120 --check"
 fi
 
+if [ -n "$plan_only" ]; then cat "$plan"; rm -rf "$logs"; exit 0; fi
 python3 -m tb3_harness.parts "$plan" "$logs"
 status=$?
 if [ $status -eq 0 ]; then rm -rf "$logs"; else echo "(the parts' logs and temporary files: $logs)"; fi
