@@ -43,9 +43,12 @@ lint() {
 }
 export -f lint
 
-# The plan, longest first within each share of the machine, so that the last
-# part to end is a short one; the wall times are of a run on this 2-core
-# machine with others' work beside it (doc/testing.md has the table).
+# The plan (tb3_harness/parts.py starts, whenever slots are free, the first
+# part in this order that fits): the parts that run alone first, while the
+# machine is empty; the rostests, the longest part; those that keep a core
+# busy, which so run one after another beside the rostests; then the rest,
+# longest first, so that the last to end is a short one. doc/testing.md has
+# what each took.
 #
 # Alone: what times wall seconds that a busy machine stretches (Ctrl+C must end
 # the simulator within 2 s; sim time's pace in a stall against the pace before).
@@ -57,6 +60,16 @@ part 3 test_stalled_reader "$pytest test/system/test_stalled_reader.py"
 # tells. SIGINT first on a time-out: rostest then stops every node it started.
 part 1 rostests "cd .ws && timeout --signal=INT --kill-after=60 3600 catkin_make run_tests &&
   catkin_test_results build/test_results"
+# A core's worth each: python's own tests, a core kept busy on purpose (at
+# factors 1 and 0), a Waffle Pi's camera rendered and shown in rviz, a catkin
+# workspace built from scratch, 120 s of sim time under random and hostile
+# commands as fast as possible.
+[ -n "$integration_only" ] || part 2 unit "$pytest test/unit"
+part 2 test_calibration.busy_core "$pytest test/system/test_calibration.py -k busy_core"
+part 2 test_readme_walkthrough.camera "$pytest test/system/test_readme_walkthrough.py -k camera"
+part 2 test_own_workspace "$pytest test/system/test_own_workspace.py"
+[ -n "$integration_only" ] ||
+  part 2 soak "timeout --signal=INT --kill-after=20 600 python3 tools/soak.py --sim-seconds 120 --check"
 # What rostest cannot stage (its master is its own): a master killed and
 # restarted, bad start-up configurations, the README typed through bash, the
 # tutorial's scripts run at factors 1, 5 and 0 against one another. Each
@@ -65,23 +78,16 @@ part 1 rostests "cd .ws && timeout --signal=INT --kill-after=60 3600 catkin_make
 # whatever the others do not name, so that a new test always runs.
 # Both `make demo`s write demo_output/: one after the other, in one share.
 part 1 demos "$pytest test/system/test_readme_walkthrough.py test/system/test_calibration.py -k make_demo"
-[ -n "$integration_only" ] || part 2 unit "$pytest test/unit"
 part 1 test_readme_walkthrough.tutorial "$pytest test/system/test_readme_walkthrough.py -k tutorial_command"
-# A core kept busy on purpose, at factors 1 and 0.
-part 2 test_calibration.busy_core "$pytest test/system/test_calibration.py -k busy_core"
 part 1 test_teleop "$pytest test/system/test_teleop.py"
-# A Waffle Pi's camera rendered and shown in rviz: a core's worth.
-part 2 test_readme_walkthrough.camera "$pytest test/system/test_readme_walkthrough.py -k camera"
-part 1 test_readme_walkthrough \
-  "$pytest test/system/test_readme_walkthrough.py -k 'not make_demo and not tutorial_command and not camera'"
 part 1 test_speed_agreement.nav_square "$pytest test/system/test_speed_agreement.py -k nav_square"
 part 1 test_speed_agreement.odom_out_and_back "$pytest test/system/test_speed_agreement.py -k odom_out_and_back"
 part 1 test_speed_agreement "$pytest test/system/test_speed_agreement.py -k 'not nav_square and not odom_out_and_back'"
+part 1 test_readme_walkthrough \
+  "$pytest test/system/test_readme_walkthrough.py -k 'not make_demo and not tutorial_command and not camera'"
 part 1 test_two_hosts "$pytest test/system/test_two_hosts.py"
 part 1 test_models "$pytest test/system/test_models.py"
 part 1 test_known_worlds "$pytest test/system/test_known_worlds.py"
-# A catkin workspace built from scratch.
-part 2 test_own_workspace "$pytest test/system/test_own_workspace.py"
 part 1 test_calibration "$pytest test/system/test_calibration.py -k 'not make_demo and not busy_core'"
 part 1 test_bad_startup "$pytest test/system/test_bad_startup.py"
 part 1 test_master_restart "$pytest test/system/test_master_restart.py"
@@ -90,11 +96,7 @@ for test_file in test/system/test_*.py; do
   name=$(basename "$test_file" .py)
   [[ "$planned" == *" $name "* ]] || part 1 "$name" "$pytest $test_file"
 done
-if [ -z "$integration_only" ]; then
-  part 1 catkin_lint lint
-  # 120 s of sim time under random and hostile commands, as fast as possible.
-  part 2 soak "timeout --signal=INT --kill-after=20 600 python3 tools/soak.py --sim-seconds 120 --check"
-fi
+[ -n "$integration_only" ] || part 1 catkin_lint lint
 
 if [ -n "$plan_only" ]; then cat "$plan"; rm -rf "$logs"; exit 0; fi
 python3 -m tb3_harness.parts "$plan" "$logs"

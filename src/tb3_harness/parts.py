@@ -12,8 +12,12 @@ needs, in SLOTS slots (3 by default):
   3  it times wall seconds that a busy machine would stretch, or loads a
      core on purpose: it runs alone.
 
-Parts start in the plan's order, each as soon as its slots are free (the
-plan puts the longest first, so that the last to end is a short one). Each
+Whenever slots are free, the first waiting part in the plan's order that
+fits in them starts: a part that needs more waits while smaller ones pass
+it, and starts as soon as enough are free at once. So the plan puts the
+parts that run alone first (the machine is empty at the start), then those
+that keep a core busy, one after another beside the rostests, then the
+rest, longest first, so that the last to end is a short one. Each
 runs in a session of its own with TB3_RUN set to a tag of its own: what it
 left running when it ends fails it (tb3_harness.leftovers). Its output goes
 to its log and is shown whole when it ends, so that parts never interleave;
@@ -79,7 +83,7 @@ def why(output):
 
 
 class Schedule(object):
-    """Which parts may start: the first waiting part, once its slots are free.
+    """Which parts may start: in the plan's order, each that fits in the free slots.
 
     Pure bookkeeping (no processes), so that the order can be tested alone."""
 
@@ -97,11 +101,14 @@ class Schedule(object):
         return self.slots - sum(self.need(part) for part in self.running)
 
     def next(self):
-        """The part to start now, or None: in the plan's order, never one past another."""
-        if self.waiting and self.need(self.waiting[0]) <= self.free():
-            part = self.waiting.pop(0)
-            self.running.append(part)
-            return part
+        """The part to start now, or None: the first in the plan's order that fits.
+        A part that does not fit yet lets later ones pass it, so that no slot idles
+        while it waits; it starts when enough slots are free at once."""
+        for part in self.waiting:
+            if self.need(part) <= self.free():
+                self.waiting.remove(part)
+                self.running.append(part)
+                return part
         return None
 
     def ended(self, part):

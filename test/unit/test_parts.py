@@ -37,21 +37,27 @@ def _order(plan, slots, durations):
 
 
 def test_parts_fill_the_slots_in_plan_order_and_an_alone_part_waits_for_an_empty_machine():
-    plan = [Part(1, 'rostests', ''), Part(2, 'unit', ''), Part(1, 'readme', ''), Part(3, 'ctrl_c', ''),
-            Part(1, 'models', '')]
-    durations = {'rostests': 10, 'unit': 4, 'readme': 3, 'ctrl_c': 2, 'models': 1}
+    plan = [Part(3, 'ctrl_c', ''), Part(1, 'rostests', ''), Part(2, 'unit', ''), Part(2, 'soak', ''),
+            Part(1, 'readme', ''), Part(1, 'models', '')]
+    durations = {'ctrl_c': 2, 'rostests': 10, 'unit': 4, 'soak': 3, 'readme': 5, 'models': 1}
     assert _order(plan, 3, durations) == [
-        ('rostests', 0, 10), ('unit', 0, 4),   # 1 + 2 slots: full
-        ('readme', 4, 7),                      # once unit's two are free
-        ('ctrl_c', 10, 12),                    # alone: after everything before it
-        ('models', 12, 13)]                    # never started past ctrl_c
+        ('ctrl_c', 0, 2),                      # alone: nothing beside it
+        ('rostests', 2, 12), ('unit', 2, 6),   # 1 + 2 slots: full
+        ('soak', 6, 9),                        # the busy ones one after another, beside the rostests
+        ('readme', 9, 14), ('models', 9, 10)]
     # One slot: one part at a time, in the plan's order.
-    assert [start for _, start, _ in _order(plan, 1, durations)] == [0, 10, 14, 17, 19]
+    assert [start for _, start, _ in _order(plan, 1, durations)] == [0, 2, 12, 16, 19, 24]
 
 
-def test_a_part_that_needs_more_slots_than_there_are_runs_alone_instead_of_never():
-    assert _order([Part(3, 'alone', ''), Part(1, 'next', '')], 2, {'alone': 5, 'next': 1}) == [
-        ('alone', 0, 5), ('next', 5, 6)]
+def test_a_part_waiting_for_slots_lets_smaller_ones_pass_and_starts_when_enough_are_free():
+    plan = [Part(1, 'a', ''), Part(1, 'b', ''), Part(2, 'busy', ''), Part(1, 'c', ''), Part(3, 'alone', ''),
+            Part(1, 'd', '')]
+    durations = {'a': 2, 'b': 5, 'busy': 4, 'c': 6, 'alone': 1, 'd': 1}
+    assert _order(plan, 3, durations) == [
+        ('a', 0, 2), ('b', 0, 5), ('c', 0, 6),   # busy does not fit beside a and b: c passes it
+        ('d', 2, 3),                             # one slot free: d passes busy and alone
+        ('busy', 5, 9),                          # two free at once
+        ('alone', 9, 10)]                        # alone at the end: everything else has passed it
 
 
 def test_why_keeps_the_lines_that_say_what_failed_once_each():
