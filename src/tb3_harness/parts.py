@@ -3,9 +3,9 @@
 A part is one command of `make test`: the unit tests, catkin_lint, a system
 test file or a share of one, the rostests, the soak. Most of them wait on
 the clock: a simulator at real time, a script driving it and a master keep
-about a third of one core busy (tools/run_tests.sh says what each part
-costs). So parts run side by side, each taking the share of the machine it
-needs, in SLOTS slots (3 by default):
+about a third of one core busy (doc/testing.md has what each part costs).
+So parts run side by side, each taking the share of the machine it needs,
+in SLOTS slots (3 by default):
 
   1  it mostly waits on real time;
   2  it keeps a core busy (the unit tests, runs as fast as possible, a build);
@@ -21,8 +21,8 @@ rest, longest first, so that the last to end is a short one. Each
 runs in a session of its own with TB3_RUN set to a tag of its own: what it
 left running when it ends fails it (tb3_harness.leftovers). Its output goes
 to its log and is shown whole when it ends, so that parts never interleave;
-at the end come a table of every part's time and the lines that say why a
-part failed, where a CI log's tail shows them.
+at the end come a table of every part's wall and CPU time and the lines
+that say why a part failed, where a CI log's tail shows them.
 
     python3 -m tb3_harness.parts PLAN [LOG_DIR]
 
@@ -135,8 +135,10 @@ class Runner(object):
         os.makedirs(log_dir, exist_ok=True)
         self.tag = 'tb3_test_%d' % os.getpid()
         self.started = {}   # name -> (Process, wall start)
-        self.results = []   # (part, start s, took s, failures: list of str)
+        self.cpu = {}       # name -> CPU s of the part's process tree, once reaped here
+        self.results = []   # (part, start s, took s, CPU s or None, failures: list of str)
         self.t0 = time.monotonic()
+        self.load = os.getloadavg()[0]
 
     def _start(self, part):
         environment = dict(os.environ, **{leftovers.TAG: '%s.%s' % (part.name, self.tag)})
@@ -151,9 +153,21 @@ class Runner(object):
                                                     '' if part.slots == 1 else 's',
                                                     ', beside ' + ', '.join(others) if others else ''))
 
-    def _finish(self, part):
+    def _ended(self, part):
+        """True once the part's command has ended: reaped here with wait4, which also
+        tells the CPU time of its whole tree (each process counted by its waiting parent)."""
+        process = self.started[part.name][0]
+        if process.popen.returncode is None:
+            pid, status, usage = os.wait4(process.pid, os.WNOHANG)
+            if pid == 0:
+                return False
+            process.popen.returncode = os.waitstatus_to_exitcode(status)
+            self.cpu[part.name] = usage.ru_utime + usage.ru_stime
+        return True
+
+    def _finish(self, part, took):
+        """Its outcome (status, leftovers), output and time, once the slots are given on."""
         process, start = self.started.pop(part.name)
-        took = time.monotonic() - start
         failures = [] if process.popen.returncode == 0 else ['exit status %s' % process.popen.returncode]
         left = leftovers.check('%s.%s' % (part.name, self.tag), part.name)
         if left:
@@ -161,38 +175,51 @@ class Runner(object):
             with open(process.log, 'a') as log:   # where `why` finds them
                 log.write(''.join('LEFT RUNNING after %s: pid %d: %s\n' % (part.name, pid, command)
                                   for pid, command in left))
-        self.schedule.ended(part)
-        self.results.append((part, start - self.t0, took, failures))
+        self.results.append((part, start - self.t0, took, self.cpu.get(part.name), failures))
         _say('== %s: %s after %s' % (part.name, 'FAILED (%s)' % '; '.join(failures) if failures else 'passed',
                                       _minutes(took)))
         sys.stdout.write(process.output(last=1 << 24))
         _say('== end of %s' % part.name)
 
+    def _start_what_fits(self):
+        part = self.schedule.next()
+        while part is not None:
+            self._start(part)
+            part = self.schedule.next()
+
     def run(self):
         try:
+            self._start_what_fits()
             while not self.schedule.done():
-                part = self.schedule.next()
-                while part is not None:
-                    self._start(part)
-                    part = self.schedule.next()
                 time.sleep(POLL)
-                for part in list(self.schedule.running):
-                    if not self.started[part.name][0].running():
-                        self._finish(part)
+                ended = [(part, time.monotonic() - self.started[part.name][1])
+                         for part in list(self.schedule.running) if self._ended(part)]
+                for part, _ in ended:
+                    self.schedule.ended(part)
+                self._start_what_fits()   # before the leftovers checks, which may wait
+                for part, took in ended:
+                    self._finish(part, took)
         finally:
             for part in [part for part in self.schedule.running if part.name in self.started]:
                 self.started[part.name][0].stop()   # interrupted: stopped as Ctrl+C would
-                self._finish(part)
+                self.schedule.ended(part)
+                self._finish(part, time.monotonic() - self.started[part.name][1])
         return self.results
 
 
-def table(results, total):
-    """The lines of the summary: each part's slots, start, time and outcome, in start order."""
-    lines = ['%-34s %5s %7s %7s  %s' % ('part', 'slots', 'start', 'took', 'result')]
-    for part, start, took, failures in sorted(results, key=lambda result: result[1]):
-        lines.append('%-34s %5d %7s %7s  %s' % (part.name, part.slots, _minutes(start), _minutes(took),
-                                                 'FAILED' if failures else 'passed'))
-    lines.append('%-34s %5s %7s %7s' % ('make test, wall', '', '', _minutes(total)))
+def table(results, total, load=None):
+    """The lines of the summary: each part's slots, start, wall and CPU time
+    (its whole process tree's), and outcome, in start order."""
+    lines = ['%-38s %5s %7s %7s %7s  %s' % ('part', 'slots', 'start', 'took', 'CPU', 'result')]
+    for part, start, took, cpu, failures in sorted(results, key=lambda result: result[1]):
+        lines.append('%-38s %5d %7s %7s %7s  %s' % (part.name, part.slots, _minutes(start), _minutes(took),
+                                                     '-' if cpu is None else _minutes(cpu),
+                                                     'FAILED' if failures else 'passed'))
+    cpu = sum(result[3] or 0.0 for result in results)
+    lines.append('%-38s %5s %7s %7s %7s' % ('make test', '', '', _minutes(total), _minutes(cpu)))
+    if load is not None:
+        lines.append('%d cores; load average (1 min) %.1f at the start, %.1f at the end'
+                     % (os.cpu_count(), load, os.getloadavg()[0]))
     return lines
 
 
@@ -212,8 +239,8 @@ def main(argv):
     except KeyboardInterrupt:
         interrupted = True
     total = time.monotonic() - runner.t0
-    _say('\n'.join([''] + table(runner.results, total)))
-    failed = [(part, failures) for part, _, _, failures in runner.results if failures]
+    _say('\n'.join([''] + table(runner.results, total, runner.load)))
+    failed = [(part, failures) for part, _, _, _, failures in runner.results if failures]
     for part, failures in failed:
         _say('== why %s failed (%s)' % (part.name, '; '.join(failures)))
         with open(os.path.join(log_dir, part.name + '.log'), errors='replace') as log:

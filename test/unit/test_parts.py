@@ -2,7 +2,6 @@
 each failing on its exit status or on what it left running, with the lines that say why."""
 import subprocess
 import sys
-import time
 
 import pytest
 
@@ -75,23 +74,30 @@ def test_why_keeps_the_lines_that_say_what_failed_once_each():
 
 
 def test_a_real_run_side_by_side_fails_on_status_and_leftovers_and_says_why(tmp_path):
-    """Three parts of a second each in three slots take about a second, not three; a part that
-    exits 1 and one that leaves a sleeper behind fail, named at the end with their lines."""
+    """Four parts in three slots: three start at once, the fourth as one ends; a part that exits 1
+    and one that leaves a sleeper behind fail, named at the end with their lines; each part's CPU
+    time is its whole process tree's."""
     plan = tmp_path / 'plan'
     plan.write_text('1 ok sleep 1; echo fine\n'
                     '1 bad sleep 1; echo "E       AssertionError: broken on purpose"; exit 1\n'
-                    '1 leaver sleep 1; (setsid sleep 60 &)\n')
-    started = time.monotonic()
+                    '1 leaver sleep 1; (setsid sleep 60 &)\n'
+                    '1 spin python3 -c "import time; end = time.process_time() + 1.5; '
+                    'exec(\'while time.process_time() < end: pass\')"\n')
     done = subprocess.run([sys.executable, '-m', 'tb3_harness.parts', str(plan), str(tmp_path / 'logs')],
                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=60)
-    took = time.monotonic() - started
     print(done.stdout)
     assert done.returncode == 1
-    assert took < 2.5 + parts.leftovers.GRACE, took   # side by side: not 3 s of sleeps plus the grace
+    assert '== leaver: started at 0:00 (1 slot, beside ok, bad)' in done.stdout   # side by side, not in turn
+    # Once a slot is free, before the 5 s the leftovers check gives the leaver's sleeper.
+    assert done.stdout.index('== spin: started') < done.stdout.index('== leaver: FAILED')
     assert '== ok: passed' in done.stdout and 'fine' in done.stdout
     assert '== bad: FAILED (exit status 1)' in done.stdout
     assert '== leaver: FAILED (left 1 process(es) running)' in done.stdout
     assert 'LEFT RUNNING after leaver' in done.stdout and 'sleep 60' in done.stdout
+    # The CPU column: a second and a half of python's own, a sleeper's next to none.
+    rows = dict((line.split()[0], line.split()[1:]) for line in done.stdout.splitlines()
+                if line.split()[:1] in (['spin'], ['ok']) and len(line.split()) == 6)
+    assert rows['spin'][3] == '0:02' and rows['ok'][3] == '0:00', rows
     tail = done.stdout[done.stdout.index('== why bad failed'):]
     assert 'E       AssertionError: broken on purpose' in tail
     assert tail.rstrip().endswith('FAILED: bad leaver') or tail.rstrip().endswith('FAILED: leaver bad')
