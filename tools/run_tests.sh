@@ -1,77 +1,105 @@
 # make test (run with bash, inside `source setup.bash`): the unit tests
-# (pytest, no master), catkin_lint, the system tests, then the integration
-# tests with catkin_make run_tests (rostest starts a master of its own on a free
-# port for each). Exit status: 0 only if all pass.
-# Each part's output is shown as it runs and kept; the lines that say why a
-# part failed are repeated at the end, where a CI log's tail shows them.
+# (pytest, no master), catkin_lint, the system tests, the integration tests
+# with catkin_make run_tests (rostest starts a master of its own on a free
+# port for each), and a short soak. Exit status: 0 only if all pass.
+#
+# The parts run side by side as tb3_harness/parts.py schedules them, each in
+# the slots its load needs (3 slots on 2 cores; TB3_TEST_SLOTS=1 runs them one
+# at a time): 1 = mostly waits on real time, 2 = keeps a core busy, 3 = alone.
+# Each part's output is shown whole when it ends; at the end come a table of
+# what each took and the lines that say why a part failed.
+#
+#   bash tools/run_tests.sh [--plan] [--integration-only] [PART ...]
+#
+# --plan prints the plan instead of running it; PART names (as in the table)
+# run only those parts.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 export ROS_HOSTNAME=localhost
 unset ROS_IP
 logs=$(mktemp -d)
-trap 'rm -rf "$logs"' EXIT
-failures=()
-
-# run NAME COMMAND...: run it, its output to the terminal and to $logs/NAME.
-# What it starts carries TB3_RUN=NAME.PID; any such process still running
-# after it fails the part (tb3_harness.leftovers names and ends it).
-run() {
-  local name=$1
-  shift
-  TB3_RUN="$name.$$" "$@" 2>&1 | tee "$logs/$name" || failures+=("$name")
-  TB3_RUN="$name.$$" python3 -m tb3_harness.leftovers check "$name" 2>&1 | tee -a "$logs/$name" \
-    || failures+=("$name (left processes running)")
+plan=$logs/plan
+integration_only= plan_only=
+if [ "${1:-}" = --plan ]; then plan_only=yes; shift; fi
+if [ "${1:-}" = --integration-only ]; then integration_only=yes; shift; fi
+only=" $* "
+pytest='python3 -m pytest -q -p no:cacheprovider'
+# part SLOTS NAME COMMAND...: a line of the plan (a command's line breaks become
+# spaces), unless PART names were given and NAME is not one.
+planned=" "
+part() {
+  planned+="$2 "
+  local line="$*"
+  if [ "$only" = "  " ] || [[ "$only" == *" $2 "* ]]; then echo "${line//$'\n'/ }" >> "$plan"; fi
 }
 
-# The lines of a failed part's output that say what failed: rostest's failure
-# headers with the message after each, pytest's short summary, the exception
-# line of each traceback, the soak's missed rows.
-why() {
-  { grep -E -A1 '\]\[(FAILURE|ERROR)\]' "$1"
-    grep -E '^(FAILED|ERROR) |(Error|Exception)(: |$)|  MISSED$|FAILED: |^Summary: |LEFT RUNNING' "$1"
-  } | grep -v '^--$' | awk '!seen[$0]++' | head -40
-}
-
-if [ "${1:-}" != --integration-only ]; then
-  echo "== unit tests (pytest, no master)"
-  run unit python3 -m pytest -q -p no:cacheprovider test/unit
-  echo "== catkin_lint"
-  lint=$(catkin_lint --strict -W2 $(for package in tb3_sim_nav gazebo_msgs map_server tb3_navigation; do
+# catkin_lint of the packages as the workspace holds them: its folder named as the package.
+lint() {
+  local output
+  output=$(catkin_lint --strict -W2 $(for package in tb3_sim_nav gazebo_msgs map_server tb3_navigation; do
     echo "$(rospack find $package)"; done) 2>&1)
-  echo "$lint" | tee "$logs/catkin_lint"
-  echo "$lint" | grep -qE ': (error|warning|notice):' && failures+=(catkin_lint)
-fi
+  echo "$output"
+  ! echo "$output" | grep -qE ': (error|warning|notice):'
+}
+export -f lint
 
-# What rostest cannot stage (its master is its own): a master killed and
-# restarted, bad start-up configurations, and the tutorial's scripts run at
-# factors 1, 5 and 0 against one another (a fresh simulator for each run).
-# One pytest process per file: a process can be one rospy node only, and each
-# file that is one talks to a master of its own.
-for test_file in test/system/test_*.py; do
-  name=$(basename "$test_file" .py)
-  echo "== system tests: $name (pytest, masters of their own)"
-  run "$name" python3 -m pytest -q -p no:cacheprovider "$test_file"
-done
-
+# The plan (tb3_harness/parts.py starts, whenever slots are free, the first
+# part in this order that fits): the parts that run alone first, while the
+# machine is empty; the rostests, the longest part; those that keep a core
+# busy, which so run one after another beside the rostests; then the rest,
+# longest first, so that the last to end is a short one. doc/testing.md has
+# what each took.
+#
+# Alone: what times wall seconds that a busy machine stretches (Ctrl+C must end
+# the simulator within 2 s; sim time's pace in a stall against the pace before).
+part 3 test_ctrl_c "$pytest test/system/test_ctrl_c.py"
+part 3 test_stalled_reader "$pytest test/system/test_stalled_reader.py"
 # The rostests (test/*.test) the ROS way, as the README shows, in make setup's
 # workspace: one at a time (CMakeLists.txt), each with a master of its own.
 # catkin_make run_tests exits 0 whatever the tests say; catkin_test_results
 # tells. SIGINT first on a time-out: rostest then stops every node it started.
-echo "== rostests: catkin_make run_tests in .ws"
-run rostests bash -c 'cd .ws && timeout --signal=INT --kill-after=60 3600 catkin_make run_tests &&
-  catkin_test_results build/test_results'
+part 1 rostests "cd .ws && timeout --signal=INT --kill-after=60 3600 catkin_make run_tests &&
+  catkin_test_results build/test_results"
+# A core's worth each: python's own tests, a core kept busy on purpose (at
+# factors 1 and 0), a Waffle Pi's camera rendered and shown in rviz, a catkin
+# workspace built from scratch, 120 s of sim time under random and hostile
+# commands as fast as possible.
+[ -n "$integration_only" ] || part 2 unit "$pytest test/unit"
+part 2 test_calibration.busy_core "$pytest test/system/test_calibration.py -k busy_core"
+part 2 test_readme_walkthrough.camera "$pytest test/system/test_readme_walkthrough.py -k camera"
+part 2 test_own_workspace "$pytest test/system/test_own_workspace.py"
+[ -n "$integration_only" ] ||
+  part 2 soak "timeout --signal=INT --kill-after=20 600 python3 tools/soak.py --sim-seconds 120 --check"
+# What rostest cannot stage (its master is its own): a master killed and
+# restarted, bad start-up configurations, the README typed through bash, the
+# tutorial's scripts run at factors 1, 5 and 0 against one another. Each
+# pytest process talks to masters of its own (a process can be one rospy node
+# only). The long files run in shares (-k), the last share of each taking
+# whatever the others do not name, so that a new test always runs.
+# Both `make demo`s write demo_output/: one after the other, in one share.
+part 1 demos "$pytest test/system/test_readme_walkthrough.py test/system/test_calibration.py -k make_demo"
+part 1 test_readme_walkthrough.tutorial "$pytest test/system/test_readme_walkthrough.py -k tutorial_command"
+part 1 test_teleop "$pytest test/system/test_teleop.py"
+part 1 test_speed_agreement.nav_square "$pytest test/system/test_speed_agreement.py -k nav_square"
+part 1 test_speed_agreement.odom_out_and_back "$pytest test/system/test_speed_agreement.py -k odom_out_and_back"
+part 1 test_speed_agreement "$pytest test/system/test_speed_agreement.py -k 'not nav_square and not odom_out_and_back'"
+part 1 test_readme_walkthrough \
+  "$pytest test/system/test_readme_walkthrough.py -k 'not make_demo and not tutorial_command and not camera'"
+part 1 test_two_hosts "$pytest test/system/test_two_hosts.py"
+part 1 test_models "$pytest test/system/test_models.py"
+part 1 test_known_worlds "$pytest test/system/test_known_worlds.py"
+part 1 test_calibration "$pytest test/system/test_calibration.py -k 'not make_demo and not busy_core'"
+part 1 test_bad_startup "$pytest test/system/test_bad_startup.py"
+part 1 test_master_restart "$pytest test/system/test_master_restart.py"
+# Every other system-test file, whole.
+for test_file in test/system/test_*.py; do
+  name=$(basename "$test_file" .py)
+  [[ "$planned" == *" $name "* ]] || part 1 "$name" "$pytest $test_file"
+done
+[ -n "$integration_only" ] || part 1 catkin_lint lint
 
-if [ "${1:-}" != --integration-only ]; then
-  echo "== short soak: 120 s of sim time under random and hostile commands"
-  run soak timeout --signal=INT --kill-after=20 600 python3 tools/soak.py --sim-seconds 120 --check
-fi
-
-if [ ${#failures[@]} -gt 0 ]; then
-  for name in "${failures[@]}"; do
-    echo "== why $name failed"
-    why "$logs/$name"
-  done
-  echo "FAILED: ${failures[*]}"
-  exit 1
-fi
-echo "ALL PASSED"
+if [ -n "$plan_only" ]; then cat "$plan"; rm -rf "$logs"; exit 0; fi
+python3 -m tb3_harness.parts "$plan" "$logs"
+status=$?
+if [ $status -eq 0 ]; then rm -rf "$logs"; else echo "(the parts' logs and temporary files: $logs)"; fi
+exit $status

@@ -151,9 +151,9 @@ def watch(sim, recorder, script, process, expected, factor, wall_start, sim_star
                             % (script, now - wall_start, sim_now() - sim_start, wall_limit, sim_limit,
                                TIMEOUT_FACTOR, expected))
         if now >= next_beat:
-            pose = recorder.truth[-1]
-            say('%s: running, sim time %.1f s, robot at x %+.2f m, y %+.2f m'
-                % (script, sim_now() - sim_start, pose[1], pose[2]))
+            pose = recorder.truth[-1] if recorder.truth else None
+            say('%s: running, sim time %.1f s, %s' % (script, sim_now() - sim_start, 'robot at x %+.2f m, y %+.2f m'
+                                                      % pose[1:3] if pose else 'no ground truth yet'))
             next_beat += HEARTBEAT
         time.sleep(0.1)
 

@@ -43,7 +43,9 @@ from tb3_test_utils import Child, init_test_node, report, wait_for
 
 RENDER_TIMEOUT = 90.0     # wall s from rviz's start to a 3D view with robot and scan
 SETTLE = 3.0              # wall s after that for transient start-up statuses to clear
-DRIVE_SECONDS = 6.0       # wall s of the tutorial's circle command
+DRIVE_SECONDS = 6.0       # sim s of the tutorial's circle command
+DRIVE_TIMEOUT = 60.0      # wall s for them to pass
+TRAIL_WITHIN = 10.0       # wall s after the stop for rviz to have drawn the trail
 MIN_COLOURS = 50          # distinct colours in the 3D view (a blank view has 1-3)
 MIN_STDDEV = 5.0          # standard deviation of the 3D view's channel values
 MIN_ROBOT_PIXELS = 40     # orange pixels of the lidar (about 200 at the spawn pose)
@@ -231,16 +233,24 @@ class RvizRenders(unittest.TestCase):
         cls.frame = Frame(screenshot(display), cls.config)
         save_png(cls.frame.image, os.path.join(cls.shots, 'settled.png'))
 
-        # The tutorial's circle, published from here at 10 Hz: the trail grows.
+        # The tutorial's circle, published from here at 10 Hz for DRIVE_SECONDS of sim
+        # time (on a busy machine the simulator runs slower than the wall clock, and
+        # rviz draws later): the trail grows.
         publisher = rospy.Publisher('/cmd_vel', Twist, queue_size=1)
         wait_for(lambda: publisher.get_num_connections() > 0, 10.0)
-        end = time.monotonic() + DRIVE_SECONDS
-        while time.monotonic() < end and not rospy.is_shutdown():
+        end, deadline = rospy.get_time() + DRIVE_SECONDS, time.monotonic() + DRIVE_TIMEOUT
+        while rospy.get_time() < end and time.monotonic() < deadline and not rospy.is_shutdown():
             publisher.publish(cls.circle)
             time.sleep(0.1)
         publisher.publish(Twist())
+        driven = []
+
+        def trail_grown():
+            driven[:] = [Frame(screenshot(display), cls.config)]
+            return driven[0].trail_pixels() - cls.frame.trail_pixels() >= MIN_NEW_TRAIL_PIXELS
         time.sleep(1.0)
-        cls.driven = Frame(screenshot(display), cls.config)
+        wait_for(trail_grown, TRAIL_WITHIN, poll=1.0)
+        cls.driven = driven[0]
         save_png(cls.driven.image, os.path.join(cls.shots, 'driven.png'))
         report('rviz_renders_frame', render_seconds=cls.render_seconds, colours=cls.frame.colours(),
                stddev=cls.frame.stddev(), robot_pixels=cls.frame.robot_pixels(),

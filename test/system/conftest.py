@@ -1,7 +1,9 @@
 """Fixtures of the system tests (see tb3_system_utils.py for what they are)."""
+import os
+
 import pytest
 
-from tb3_system_utils import Processes, harness, master_uri
+from tb3_system_utils import MASTER_TIMEOUT, Processes, harness, master_uri, wait_until
 
 
 @pytest.fixture
@@ -21,3 +23,51 @@ def processes(tmp_path):
         yield started
     finally:
         started.stop_all()
+
+
+@pytest.fixture(scope='module')
+def module_master(tmp_path_factory):
+    """One roscore for a module's tests, on a free loopback port, with this
+    process's ROS environment pointed at it: a roscore costs 2-3 wall s to
+    start and 1 to stop (measured), which tests that only need a master pay
+    once this way. See `shared_master`."""
+    port = harness.free_port()
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv('ROS_MASTER_URI', master_uri(port))
+        patch.setenv('ROS_HOSTNAME', 'localhost')
+        patch.delenv('ROS_IP', raising=False)
+        started = Processes(tmp_path_factory.mktemp('module_master'))
+        try:
+            started.start_master('roscore', port)
+            import rosgraph
+            server = rosgraph.Master('/tb3_test')
+            # roscore sets its parameters and starts rosout after its master answers.
+            assert wait_until(lambda: server.hasParam('/run_id') and _registered(server, '/rosout'), MASTER_TIMEOUT), \
+                'roscore -p %d: no /run_id or /rosout within %.0f s' % (port, MASTER_TIMEOUT)
+            yield port, set(server.getParamNames())
+        finally:
+            started.stop_all()
+
+
+@pytest.fixture
+def shared_master(module_master):
+    """The module's roscore, as a fresh one would be to a test that starts its
+    own nodes: the parameters it started with, and only those, at the start of
+    each test (a launch sets its parameters, and a test may set more; a node
+    never sees those of an earlier test). Its port."""
+    import rosgraph
+    port, baseline = module_master
+    assert os.environ['ROS_MASTER_URI'] == master_uri(port)
+    server = rosgraph.Master('/tb3_test')
+    for name in sorted(set(server.getParamNames()) - baseline):
+        if server.hasParam(name):   # gone with a namespace deleted before it
+            server.deleteParam(name)
+    return port
+
+
+def _registered(server, node):
+    try:
+        server.lookupNode(node)
+        return True
+    except Exception:  # rosgraph.MasterError: not (yet) registered
+        return False

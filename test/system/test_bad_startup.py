@@ -1,6 +1,6 @@
 """Bad start-up configurations end `roslaunch` with an error that says what is wrong.
 
-Against a roscore of its own (a free loopback port), each case runs
+Against a roscore (one for all, on a free loopback port), each case runs
 `roslaunch tb3_sim_bringup LAUNCH ARGS` as the user would. The simulator node
 is required="true": when it refuses to start, roslaunch must end within 60 s,
 an error line of its output (not roslaunch's listing of the parameters) must
@@ -53,13 +53,8 @@ CASES = ['negative_real_time_factor', 'unknown_model', 'missing_world_file', 'ma
          'spawn_inside_central_pillar', 'real_time_factor_not_a_number', 'camera_rate_above_physics_rate']
 
 
-@pytest.fixture
-def master(ros_port, processes):
-    return processes.start_master('roscore', ros_port)
-
-
 @pytest.mark.parametrize('case', CASES)
-def test_start_up_fails_nonzero_naming_parameter_or_file_and_value(case, master, processes, tmp_path):
+def test_start_up_fails_nonzero_naming_parameter_or_file_and_value(case, shared_master, processes, tmp_path):
     launch, arguments, expected, parameters = (cases(tmp_path)[case] + ({},))[:4]
     import rosgraph
     for name, value in parameters.items():

@@ -46,6 +46,18 @@ def children(pid):
     return found
 
 
+def registered(node, pid):
+    """True once process `pid` has registered as `node` with the master."""
+    import xmlrpc.client
+
+    import rosgraph
+    try:
+        uri = rosgraph.Master('/tb3_ctrl_c_test').lookupNode(node)
+        return xmlrpc.client.ServerProxy(uri).getPid('/tb3_ctrl_c_test')[2] == pid
+    except Exception:  # not (yet) registered, an earlier one's gone, no master
+        return False
+
+
 def simulator_of(launch):
     """The pid of the launch's tb3_sim_node, once started."""
     found = wait_until(lambda: [pid for pid, command in children(launch.pid).items() if 'tb3_sim_node' in command],
@@ -59,10 +71,15 @@ def start_world(processes, factor, tag):
     return processes.start('roslaunch_%s' % tag, LAUNCH + ['real_time_factor:=%g' % factor], env=env)
 
 
-def suspended_reader(processes, tag):
-    """`rostopic echo /scan`, stopped (as Ctrl+Z) once it has printed a scan."""
-    reader = processes.start('echo_%s' % tag, ['rostopic', 'echo', '/scan'],
-                             env=dict(os.environ, PYTHONUNBUFFERED='1', **{leftovers.TAG: tag}))
+def scan_reader(processes, tag):
+    """`rostopic echo /scan`, started beside the launch (their start-ups overlap:
+    each takes 2-4 wall s of python on a busy machine); see suspend."""
+    return processes.start('echo_%s' % tag, ['rostopic', 'echo', '/scan'],
+                           env=dict(os.environ, PYTHONUNBUFFERED='1', **{leftovers.TAG: tag}))
+
+
+def suspend(reader):
+    """The reader stopped (as Ctrl+Z) once it has printed a scan."""
     assert wait_until(lambda: 'ranges' in reader.output(1 << 22), READY_TIMEOUT, poll=0.05), reader.describe()
     reader.signal_group(signal.SIGSTOP)
     return reader
@@ -78,8 +95,9 @@ def test_ctrl_c_ends_the_simulator_within_2_s_every_time(ros_port, processes):
         factor = (0.0, 1.0)[press % 2]
         tag = 'ctrl_c_%d' % press
         launch = start_world(processes, factor, tag)
+        reader = scan_reader(processes, tag)
         simulator = simulator_of(launch)
-        reader = suspended_reader(processes, tag)
+        suspend(reader)
         time.sleep(rng.uniform(0.0, 3.0))
         assert alive(simulator), launch.describe()
         os.kill(launch.pid, signal.SIGINT)  # as the terminal's Ctrl+C: to roslaunch alone
@@ -105,8 +123,10 @@ def test_the_simulator_ends_when_roslaunch_is_killed(ros_port, processes):
         tag = 'kill_%g' % factor
         launch = start_world(processes, factor, tag)
         simulator = simulator_of(launch)
-        assert wait_until(lambda: 'started core service' in launch.output() or 'tb3_sim' in launch.output(),
-                          READY_TIMEOUT)
+        # Registered: its parent watch runs. (roslaunch's own line naming tb3_sim comes
+        # when it forks the node; killed before the node has even imported rospy, 4 s
+        # later on a busy machine, the node would find no roslaunch to watch.)
+        assert wait_until(lambda: registered('/tb3_sim', simulator), READY_TIMEOUT), launch.describe()
         time.sleep(2.0)
         os.kill(launch.pid, signal.SIGKILL)
         killed = time.monotonic()
@@ -129,8 +149,9 @@ def test_every_other_way_to_end_the_simulator_takes_under_2_s(how, ros_port, pro
         processes.start('hz%s' % topic.replace('/', '_'), ['rostopic', 'hz', topic])
     tag = how.replace(' ', '_').replace('+', '')
     launch = start_world(processes, 0.0, tag)
+    reader = scan_reader(processes, tag)
     simulator = simulator_of(launch)
-    reader = suspended_reader(processes, tag)
+    suspend(reader)
     if how == 'Ctrl+C while paused':
         assert run(['rosservice', 'call', '/gazebo/pause_physics'], 30.0).returncode == 0
     time.sleep(1.0)

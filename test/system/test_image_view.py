@@ -14,7 +14,7 @@ def test_image_view_shows_the_waffle_pis_camera(ros_port, processes, tmp_path):
     processes.start_master('roscore', ros_port)
     sim = processes.start('sim', ['roslaunch', '--wait', 'tb3_sim_bringup', 'tb3_world.launch', 'model:=waffle_pi'])
     xvfb, display = start_xvfb()
-    processes.started.append(xvfb)
+    processes.add(xvfb, server=True)
     viewer = processes.start('image_view', ['rosrun', 'image_view', 'image_view', 'image:=/camera/rgb/image_raw'],
                              env=dict(os.environ, DISPLAY=display))
     shots = []

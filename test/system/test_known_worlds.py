@@ -1,7 +1,8 @@
 """ROBOTIS' worlds through their launches, started as a user starts them.
 
 For each of tb3_house.launch and tb3_stage_1.launch ... tb3_stage_4.launch,
-against a roscore of its own (a free loopback port) and with
+against a roscore (one for the file, on a free loopback port, its parameters
+cleared between launches: conftest.py's shared_master) and with
 TURTLEBOT3_MODEL=burger in the environment, as a TurtleBot3 user has it:
 `roslaunch tb3_sim_bringup LAUNCH` with no arguments, then `rostopic echo -n 1`
 of /base_pose_ground_truth (after REST s of sim time) and of /scan. The robot
@@ -47,9 +48,8 @@ def stamp(message):
 
 
 @pytest.mark.parametrize('command', COMMANDS)
-def test_the_robot_rests_at_the_launch_spawn_pose_and_its_lidar_sees_walls(command, ros_port, processes):
+def test_the_robot_rests_at_the_launch_spawn_pose_and_its_lidar_sees_walls(command, shared_master, processes):
     launch = command.split()[-1]
-    processes.start_master('roscore', ros_port)
     sim = processes.start('roslaunch', command.split(), env=dict(os.environ, TURTLEBOT3_MODEL='burger'))
     truth = echo('/base_pose_ground_truth', sim)
     while stamp(truth) < REST:
@@ -71,10 +71,9 @@ def test_the_robot_rests_at_the_launch_spawn_pose_and_its_lidar_sees_walls(comma
     assert len(seen) >= len(ranges) // 4, ranges  # the lidar sees walls
 
 
-def test_multi_tb3_launch_puts_three_robots_in_the_house_as_robotis_does(ros_port, processes):
+def test_multi_tb3_launch_puts_three_robots_in_the_house_as_robotis_does(shared_master, processes):
     """`roslaunch tb3_sim_bringup multi_tb3.launch`, no arguments: tb3_0, tb3_1 and tb3_2 rest at the
     launch's default poses in turtlebot3_house (ROBOTIS': (-7, -1) and (7, -1) facing +y, (0.5, 3))."""
-    processes.start_master('roscore', ros_port)
     sim = processes.start('roslaunch', ['roslaunch', 'tb3_sim_bringup', 'multi_tb3.launch'],
                           env=dict(os.environ, TURTLEBOT3_MODEL='burger'))
     root = ElementTree.parse(os.path.join(REPO, 'launch', 'multi_tb3.launch')).getroot()

@@ -16,7 +16,7 @@ import subprocess
 import yaml
 
 from tb3_harness.screen import start_xvfb
-from tb3_system_utils import run, wait_until
+from tb3_system_utils import Echo, poses, run, wait_until
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 TIMEOUT = 60.0        # wall s for one short command, one message or a start-up
@@ -30,9 +30,9 @@ def bash(command):
     return ['bash', '-c', command]
 
 
-def echo(topic):
-    """One message of `topic`, as `rostopic echo -n 1` prints it, parsed."""
-    printed = run(['rostopic', 'echo', '-n', '1', topic], TIMEOUT)
+def echo(topic, *options):
+    """One message of `topic`, as `rostopic echo -n 1 [OPTIONS]` prints it, parsed."""
+    printed = run(['rostopic', 'echo', '-n', '1'] + list(options) + [topic], TIMEOUT)
     assert printed.returncode == 0, 'rostopic echo -n 1 %s: %s' % (topic, printed.stdout[-1000:])
     return next(yaml.safe_load_all(printed.stdout))
 
@@ -53,20 +53,42 @@ def pose_of(message):
             twist['linear']['x'], twist['angular']['z'])
 
 
-def truth():
-    return pose_of(echo('/base_pose_ground_truth'))
-
-
 def start(processes, name, command, **popen):
     return processes.start(name, bash(command), **popen)
 
 
-def start_sim(processes, command, **popen):
-    """The simulator by `command`, once its ground truth comes."""
-    sim = start(processes, 'sim', command, **popen)
-    printed = run(['rostopic', 'echo', '-n', '1', '/base_pose_ground_truth'], TIMEOUT)
-    assert printed.returncode == 0 and sim.running(), sim.describe()
-    return sim
+class Truth(object):
+    """/base_pose_ground_truth from one `rostopic echo -p` for the whole test
+    (tb3_system_utils.Echo), through the simulator's restarts; each look is a
+    tuple (x, y, yaw, speed, turn), the speed unsigned."""
+
+    def __init__(self, processes):
+        self.echo = Echo(processes, '/base_pose_ground_truth')
+
+    @staticmethod
+    def _tuple(row):
+        pose = poses(None, [row])[0]
+        return pose['x'], pose['y'], pose['yaw'], pose['speed'], pose['turn']
+
+    def latest(self):
+        rows = self.echo.rows()
+        return self._tuple(rows[-1]) if rows else None
+
+    def fresh(self):
+        """The first message after this call, as `rostopic echo -n 1` would print it."""
+        row = self.echo.after(self.echo.count(), TIMEOUT)
+        assert row is not None, 'no ground truth within %.0f s' % TIMEOUT
+        return self._tuple(row)
+
+    def start_sim(self, processes, command, **popen):
+        """The simulator by `command`, once its ground truth comes: its first message
+        (its clock starts from zero: a late message of the one before is older)."""
+        rows = self.echo.rows()
+        before = poses(None, rows[-1:])[0]['t'] if rows else math.inf
+        sim = start(processes, 'sim', command, **popen)
+        first = self.echo.after(len(rows), TIMEOUT, lambda row: int(row['field.header.stamp']) * 1e-9 < before)
+        assert first is not None and sim.running(), sim.describe()
+        return sim, self._tuple(first)
 
 
 def run_script(command):
@@ -95,24 +117,27 @@ def test_source_setup_bash_gives_debians_rospy_whatever_python_comes_first(tmp_p
 
 def test_the_tutorial_command_by_command(ros_port, processes):
     processes.start_master('roscore', ros_port)
-    sim = start_sim(processes, 'roslaunch tb3_sim_bringup tb3_empty_world.launch')
+    truth = Truth(processes)
+    sim, _ = truth.start_sim(processes, 'roslaunch tb3_sim_bringup tb3_empty_world.launch')
     xvfb, display = start_xvfb()
-    processes.started.append(xvfb)
+    processes.add(xvfb, server=True)
     rviz = start(processes, 'rviz', 'rosrun rviz rviz -d `rospack find tb3_sim_bringup`/rviz/demo.rviz',
                  env=dict(os.environ, DISPLAY=display))
 
     # 1. The circle holds after Ctrl+C; the empty Twist stops it.
     circle = start(processes, 'circle', "rostopic pub -r 10 /cmd_vel geometry_msgs/Twist "
                                         "'{linear: {x: 0.1, y: 0, z: 0}, angular: {x: 0, y: 0, z: -0.5}}'")
-    assert wait_until(lambda: abs(truth()[3] - 0.1) < 0.01, TIMEOUT), 'the circle did not start: %s' % (truth(),)
+    assert wait_until(lambda: abs(truth.latest()[3] - 0.1) < 0.01, TIMEOUT), \
+        'the circle did not start: %s' % (truth.latest(),)
     circle.signal_group(signal.SIGINT)
     assert circle.wait(TIMEOUT) is not None, 'rostopic pub did not end on Ctrl+C'
-    x, y, yaw, speed, turn = truth()
+    x, y, yaw, speed, turn = truth.fresh()
     print('MEASURED after Ctrl+C: speed %.3f m/s, turn %.3f rad/s' % (speed, turn))
     assert abs(speed - 0.1) < 0.01 and abs(turn + 0.5) < 0.05  # the last command holds
     assert abs(math.hypot(x, y + 0.2) - 0.2) < 0.02  # on the circle of radius 0.2 m around (0, -0.2)
     call("rostopic pub -1 /cmd_vel geometry_msgs/Twist '{}'")
-    assert wait_until(lambda: abs(truth()[3]) < 1e-3 and abs(truth()[4]) < 1e-3, TIMEOUT), truth()
+    assert wait_until(lambda: abs(truth.latest()[3]) < 1e-3 and abs(truth.latest()[4]) < 1e-3, TIMEOUT), \
+        truth.latest()
 
     # rviz shows demo.rviz, the world's obstacles included.
     assert rviz.running(), rviz.describe()
@@ -123,14 +148,14 @@ def test_the_tutorial_command_by_command(ros_port, processes):
     for script, back_within in (('rosrun tb3_sim_nav timed_out_and_back.py', 0.15),
                                 ('rosrun tb3_sim_nav odom_out_and_back.py', 0.05)):
         sim.stop()
-        sim = start_sim(processes, 'roslaunch tb3_sim_bringup tb3_empty_world.launch')
-        assert distance(truth(), ORIGIN) < 1e-3  # back at the origin
+        sim, first = truth.start_sim(processes, 'roslaunch tb3_sim_bringup tb3_empty_world.launch')
+        assert distance(first, ORIGIN) < 1e-3  # back at the origin
         run_script(script)
-        end = truth()
+        end = truth.fresh()
         print('MEASURED %s: ends %.3f m from the start' % (script, distance(end, ORIGIN)))
         assert distance(end, ORIGIN) < back_within
     run_script('rosrun tb3_sim_nav nav_square.py')
-    square_end = truth()
+    square_end = truth.fresh()
     print('MEASURED nav_square.py: ends %.3f m from its start' % distance(square_end, end))
     assert distance(square_end, end) < 0.1
     assert rviz.running(), rviz.describe()
@@ -156,9 +181,10 @@ def test_make_demo(tmp_path):
 def test_the_realistic_profile_drifts(ros_port, processes):
     """The realistic profile's odometry drifts from the truth; the closed-loop script still comes back."""
     processes.start_master('roscore', ros_port)
-    start_sim(processes, 'roslaunch tb3_sim_bringup tb3_empty_world.launch profile:=realistic')
+    truth = Truth(processes)
+    truth.start_sim(processes, 'roslaunch tb3_sim_bringup tb3_empty_world.launch profile:=realistic')
     run_script('rosrun tb3_sim_nav odom_out_and_back.py')
-    end, odom = truth(), pose_of(echo('/odom'))
+    end, odom = truth.fresh(), pose_of(echo('/odom'))
     print('MEASURED realistic odom_out_and_back.py: ends %.3f m from the start, odometry %.3f m off the truth'
           % (distance(end, ORIGIN), distance(end, odom)))
     assert distance(end, ORIGIN) < 0.1
@@ -167,9 +193,10 @@ def test_the_realistic_profile_drifts(ros_port, processes):
 
 def test_another_model_and_its_camera_in_rviz(ros_port, processes):
     processes.start_master('roscore', ros_port)
-    start_sim(processes, 'export TURTLEBOT3_MODEL=waffle_pi\nroslaunch tb3_sim_bringup tb3_world.launch')
+    Truth(processes).start_sim(processes,
+                               'export TURTLEBOT3_MODEL=waffle_pi\nroslaunch tb3_sim_bringup tb3_world.launch')
     xvfb, display = start_xvfb()
-    processes.started.append(xvfb)
+    processes.add(xvfb, server=True)
     rviz = start(processes, 'rviz', 'export TURTLEBOT3_MODEL=waffle_pi\n'
                  'rosrun rviz rviz -d `rospack find tb3_sim_bringup`/rviz/camera.rviz',
                  env=dict(os.environ, DISPLAY=display))
@@ -177,21 +204,25 @@ def test_another_model_and_its_camera_in_rviz(ros_port, processes):
     assert (info['width'], info['height']) == (640, 480)
     assert wait_until(lambda: re.search(r'Subscribers:\s*\n\s*\* /rviz',
                                         run(['rostopic', 'info', '/camera/rgb/image_raw'], TIMEOUT).stdout), TIMEOUT)
-    image = echo('/camera/rgb/image_raw')
+    # --noarr: the pixels as their count; as YAML, 921,600 numbers took 28 s to parse (measured).
+    image = echo('/camera/rgb/image_raw', '--noarr')
     assert (image['width'], image['height'], image['encoding']) == (640, 480, 'rgb8')
+    assert image['data'] == '<array type: uint8, length: %d>' % (640 * 480 * 3)
     assert rviz.running(), rviz.describe()
 
 
 def test_gazebos_model_services_and_a_script_written_for_gazebo(ros_port, processes):
     processes.start_master('roscore', ros_port)
-    start_sim(processes, 'roslaunch tb3_sim_bringup tb3_world.launch', env=dict(os.environ, TURTLEBOT3_MODEL='burger'))
+    truth = Truth(processes)
+    truth.start_sim(processes, 'roslaunch tb3_sim_bringup tb3_world.launch',
+                    env=dict(os.environ, TURTLEBOT3_MODEL='burger'))
     state = call("rosservice call /gazebo/get_model_state '{model_name: turtlebot3_burger}'")
     assert state['success'] is True
     assert distance((state['pose']['position']['x'], state['pose']['position']['y']), (-2.0, -0.5)) < 0.01
     moved = call("rosservice call /gazebo/set_model_state '{model_state: {model_name: turtlebot3_burger, "
                  "pose: {position: {x: -2.0, y: 0.5}, orientation: {w: 1.0}}}}'")
     assert moved['success'] is True, moved
-    assert wait_until(lambda: distance(truth(), (-2.0, 0.5)) < 0.01, TIMEOUT), truth()
+    assert wait_until(lambda: distance(truth.latest(), (-2.0, 0.5)) < 0.01, TIMEOUT), truth.latest()
     assert distance(pose_of(echo('/odom')), (-2.0, 0.5)) < 0.01  # Gazebo's odom jumps with the robot
 
     goal = start(processes, 'goal_box', 'rosrun tb3_sim_nav goal_box.py', env=dict(os.environ, PYTHONUNBUFFERED='1'))

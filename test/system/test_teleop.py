@@ -1,7 +1,8 @@
 """The keyboard teleop (scripts/tb3_teleop_key), typed at through a pseudo-terminal.
 
-Each test has a roscore of its own on a free loopback port (conftest.py's
-fixtures); the tests that look at the robot also start the simulator
+The tests share a roscore on a free loopback port, its parameters cleared
+between tests (conftest.py's shared_master); the one without a master has a
+port of its own with none; the tests that look at the robot start the simulator
 (`roslaunch tb3_sim_bringup tb3_empty_world.launch`). The teleop runs in a
 session of its own whose controlling terminal is a pty whose master side this
 test holds (util-linux `setsid --ctty`), as a shell's job in a terminal
@@ -25,7 +26,7 @@ import time
 
 import pytest
 
-from tb3_system_utils import alive, harness, run, wait_until
+from tb3_system_utils import Echo, alive, harness, poses, run, wait_until
 
 TELEOP = ['rosrun', 'tb3_sim_nav', 'tb3_teleop_key']
 MULTI = ['roslaunch', 'tb3_sim_bringup', 'multi_tb3.launch']
@@ -103,48 +104,11 @@ class PtyProcess(harness.Process):
         return code
 
 
-class Echo(object):
-    """`rostopic echo -p TOPIC` to a log file, read back as rows of CSV."""
-
-    def __init__(self, processes, topic):
-        self.process = processes.start('echo' + topic.replace('/', '_'), ['rostopic', 'echo', '-p', topic])
-
-    def rows(self):
-        """Every complete line as a dict of column name -> text."""
-        with open(self.process.log, errors='replace') as log:
-            lines = log.read().split('\n')[:-1]   # the last line may be half written
-        header, rows = None, []
-        for line in lines:
-            if line.startswith('%time,'):
-                header = line[1:].split(',')
-            elif header and line[:1].isdigit() and line.count(',') == len(header) - 1:
-                rows.append(dict(zip(header, line.split(','))))
-        return rows
-
-
 def twists(echo):
     """cmd_vel messages as (linear x, y, z, angular x, y, z)."""
     names = ['field.linear.x', 'field.linear.y', 'field.linear.z',
              'field.angular.x', 'field.angular.y', 'field.angular.z']
     return [tuple(float(row[name]) for name in names) for row in echo.rows()]
-
-
-def poses(echo):
-    """Ground truth as dicts: t (sim s), x, y, yaw, speed (m/s), turn (rad/s)."""
-    result = []
-    for row in echo.rows():
-        f = {name: float(value) for name, value in row.items() if name.startswith('field.') and
-             ('position' in name or 'orientation' in name or 'twist.twist' in name)}
-        qx, qy, qz, qw = (f['field.pose.pose.orientation.' + axis] for axis in 'xyzw')
-        result.append({
-            't': int(row['field.header.stamp']) * 1e-9,
-            'x': f['field.pose.pose.position.x'],
-            'y': f['field.pose.pose.position.y'],
-            'yaw': math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz)),
-            'speed': math.hypot(f['field.twist.twist.linear.x'], f['field.twist.twist.linear.y']),
-            'turn': f['field.twist.twist.angular.z'],
-        })
-    return result
 
 
 def last(items):
@@ -180,8 +144,9 @@ def unbuffered(monkeypatch):
 
 
 @pytest.fixture
-def master(ros_port, processes):
-    return processes.start_master('roscore', ros_port)
+def master(shared_master):
+    """The file's roscore, its parameters as it started (conftest.py)."""
+    return shared_master
 
 
 @pytest.fixture
@@ -198,7 +163,7 @@ def truth(master, processes):
 def start_teleop(processes, tmp_path, cmd_vel, argv=TELEOP, name='teleop'):
     """The teleop in a pty, once it shows its keys and /cmd_vel's reader has its messages."""
     teleop = PtyProcess(name, argv, str(tmp_path))
-    processes.started.append(teleop)
+    processes.add(teleop)
     ready = wait_until(lambda: ('Ctrl+C' in teleop.output() and twists(cmd_vel)) or not teleop.running(),
                        START_WITHIN)
     assert ready and teleop.running(), 'the teleop did not start within %.0f s; it printed:\n%s' % (
@@ -340,7 +305,7 @@ def test_speeds_held_to_the_model_limits(model, via, master, processes, tmp_path
 def test_unknown_model_exits_nonzero_naming_the_three(master, processes, tmp_path, monkeypatch):
     monkeypatch.setenv('TURTLEBOT3_MODEL', 'burger')
     teleop = PtyProcess('teleop', TELEOP + ['_model:=turtlebot4'], str(tmp_path))
-    processes.started.append(teleop)
+    processes.add(teleop)
     ended = wait_until(lambda: not teleop.running(), START_WITHIN)
     # Its output may still be on its way through the pty.
     named = wait_until(lambda: 'turtlebot4' in teleop.output(), 2.0)
