@@ -15,6 +15,8 @@ The screenshots go to ~/.ros/test_results/tb3_sim_nav/emanual/ (doc/'s
 pictures are copies): what rviz shows at each step must be there, the map
 in the SLAM's, the plan, the costmap and the particles in navigation's.
 """
+import json
+import math
 import os
 import shutil
 import signal
@@ -31,8 +33,11 @@ TIMEOUT = 60.0
 EXPORT = 'export TURTLEBOT3_MODEL=burger'
 SHOTS = os.path.join(rospkg.get_ros_home(), 'test_results', 'tb3_sim_nav', 'emanual')
 GOAL = (0.55, 0.55, 1.5708)
+#: Where the loop ends: back at the spawn, facing west (map coordinates are the world's, as odom's are).
+END_OF_LOOP = (-2.0, -0.5, 3.1416)
 INITIAL_POSE = ("rostopic pub -1 /initialpose geometry_msgs/PoseWithCovarianceStamped '{header: {frame_id: map}, "
-                "pose: {pose: {position: {x: -2.0, y: -0.5}, orientation: {w: 1.0}}, covariance: [0.25, 0, 0, 0, 0, "
+                "pose: {pose: {position: {x: -2.0, y: -0.5}, orientation: {z: 1.0, w: 0.0}}, covariance: [0.25, 0, 0, "
+                "0, 0, "
                 "0, 0, 0.25, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, "
                 "0.06853891945]}}'")
 NAV_GOAL = ("rostopic pub -1 /move_base_simple/goal geometry_msgs/PoseStamped '{header: {frame_id: map}, pose: "
@@ -43,8 +48,21 @@ def bash(command):
     return ['bash', '-c', '%s && %s' % (EXPORT, command)]
 
 
+UNKNOWN = (92, 110, 108)  # rviz's "map" scheme: an unknown cell (-1) on the view's background
+FLOOR = (192, 192, 192)   # a free cell (0)
+WALL = (14, 14, 14)       # an occupied one (100)
+
+
 def colour_pixels(image, colour, tolerance=25):
     return int((np.abs(image.astype(int) - np.array(colour)).max(axis=2) <= tolerance).sum())
+
+
+def map_view(image):
+    """The part of a screenshot where rviz draws the map: the box round its unknown cells (the
+    desktop round rviz's window is black, and so is the text of its panels)."""
+    rows, cols = np.nonzero((np.abs(image.astype(int) - np.array(UNKNOWN)).max(axis=2) <= 3))
+    assert rows.size > 1000, 'no map in rviz: %d unknown-cell pixels' % rows.size
+    return image[rows.min():rows.max() + 1, cols.min():cols.max() + 1]
 
 
 def shot(display, name):
@@ -75,9 +93,14 @@ def test_map_save_and_navigate_as_the_emanual_does(ros_port, processes, desktop)
     driven = run(['python3', '-m', 'tb3_harness.route_driver', 'world_loop', '--out', os.path.join(home, 'route.json')],
                  900)
     assert driven.returncode == 0 and sim.running() and slam.running(), (driven.stdout[-2000:], slam.describe())
-    mapping = shot(display, 'slam.png')
+    with open(os.path.join(home, 'route.json')) as stream:
+        end = json.load(stream)['truth'][-1][1:]
+    # The 2D Pose Estimate below is typed for the loop's end, as a learner clicks where rviz shows the robot.
+    assert math.hypot(end[0] - END_OF_LOOP[0], end[1] - END_OF_LOOP[1]) < 0.1, end
+    assert abs(math.remainder(end[2] - END_OF_LOOP[2], 2 * math.pi)) < 0.2, end
+    mapping = map_view(shot(display, 'slam.png'))
     # rviz's "map" scheme: occupied cells black, free ones light grey; the scan's flat green.
-    walls, floor = colour_pixels(mapping, (0, 0, 0), 10), colour_pixels(mapping, (205, 205, 205), 30)
+    walls, floor = colour_pixels(mapping, WALL, 8), colour_pixels(mapping, FLOOR, 8)
     scan = colour_pixels(mapping, (0, 255, 0), 40)
     print('MEASURED rviz during SLAM: %d wall pixels, %d floor pixels, %d scan pixels' % (walls, floor, scan))
     assert walls > 2000 and floor > 20000 and scan > 300
@@ -94,16 +117,22 @@ def test_map_save_and_navigate_as_the_emanual_does(ros_port, processes, desktop)
     assert wait_until(lambda: nav.output(20000).count('map of') >= 2, TIMEOUT), nav.describe()
     assert run(bash(INITIAL_POSE), TIMEOUT).returncode == 0
     result = processes.start('result', ['rostopic', 'echo', '-n', '1', '/move_base/result'])
-    assert run(bash(NAV_GOAL), TIMEOUT).returncode == 0
+    # As fast as possible, the drive takes seconds: rviz is watched from the click on.
+    goal = processes.start('goal', bash(NAV_GOAL))
     seen = []
+
+    counts = []
 
     def navigating():
         image = screenshot(display)
         plan = colour_pixels(image, (0, 0, 255), 30)
+        counts.append(plan)
         if plan > 150:
             seen[:] = [image, plan]
+        else:
+            save_png(image, os.path.join(SHOTS, 'navigation_last_without_plan.png'))
         return bool(seen)
-    assert wait_until(navigating, 120, poll=0.5), 'no global plan drawn in rviz'
+    assert wait_until(navigating, 120, poll=0.5), 'no global plan drawn in rviz: plan pixels %s' % counts
     image, plan = seen
     os.makedirs(SHOTS, exist_ok=True)
     save_png(image, os.path.join(SHOTS, 'navigation.png'))
@@ -112,8 +141,10 @@ def test_map_save_and_navigate_as_the_emanual_does(ros_port, processes, desktop)
     print('MEASURED rviz while navigating: %d plan pixels, %d particle pixels, %d costmap (cyan) pixels'
           % (plan, particles, costmap_cyan))
     assert particles > 50 and costmap_cyan > 200
+    assert goal.wait(TIMEOUT) == 0, goal.describe()
     assert wait_until(lambda: not result.running(), 180), 'no move_base result within 180 s'
-    outcome = yaml.safe_load(result.output().split('---')[0])
+    echoed = result.output()  # rostopic may warn first ("Is /clock being published?")
+    outcome = yaml.safe_load(echoed[echoed.index('header:'):].split('---')[0])
     print('MEASURED 2D Nav Goal: status %s, %s' % (outcome['status']['status'], outcome['status']['text']))
     assert outcome['status']['status'] == 3, outcome
     shutil.copy(os.path.join(home, 'map.pgm'), os.path.join(SHOTS, 'map.pgm'))

@@ -45,6 +45,10 @@ ABORT_TEXT = {  # move_base's words
     PLANNING_R: 'Failed to find a valid plan. Even after executing recovery behaviors.',
     CONTROLLING_R: 'Failed to find a valid control. Even after executing recovery behaviors.',
     OSCILLATION_R: 'Robot is oscillating. Even after executing recovery behaviors.'}
+#: What started the recoveries, as the node logs it beside each behaviour.
+TRIGGER_TEXT = {PLANNING_R: 'no valid plan within planner_patience',
+                CONTROLLING_R: 'no valid command within controller_patience',
+                OSCILLATION_R: 'not moving oscillation_distance within oscillation_timeout'}
 STOP = (0.0, 0.0)
 DEFAULT_RECOVERIES = ('conservative_reset', 'rotate_recovery', 'aggressive_reset', 'rotate_recovery')
 
@@ -298,6 +302,11 @@ class Navigator(object):
             return ()
         return tuple(name for name in config.recovery_behaviors
                      if config.clearing_rotation_allowed or name != 'rotate_recovery')
+
+    @property
+    def recovery_reason(self):
+        """Why the recoveries run (TRIGGER_TEXT)."""
+        return TRIGGER_TEXT[self._trigger]
 
     def _clear(self, now, pose, global_to_local, new_plan):
         started, local = None, compose(global_to_local, pose)  # the rotation is watched in the local frame

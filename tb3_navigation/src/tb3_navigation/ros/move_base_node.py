@@ -222,7 +222,7 @@ class MoveBaseNode(object):
         if step.local_plan is not None and len(step.local_plan):
             self.local_plan_pub.publish(_path(step.local_plan, self.local_io.frame, stamp))
         if step.recovery:
-            rospy.logwarn('%s: recovery behaviour %s', NODE, step.recovery)
+            rospy.logwarn('%s: recovery behaviour %s (%s)', NODE, step.recovery, self.navigator.recovery_reason)
         outcome = step.outcome
         if outcome is not None and self.server.is_active():
             if outcome.status == SUCCEEDED:
