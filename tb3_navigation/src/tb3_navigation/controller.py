@@ -61,8 +61,8 @@ class DwaConfig:
     acc_lim_x: float = 2.5  # m/s^2
     acc_lim_y: float = 0.0  # a differential base: 0
     acc_lim_theta: float = 3.2  # rad/s^2
-    xy_goal_tolerance: float = 0.05  # m: the goal is reached this near (the controller aims at 0.3 of it)
-    yaw_goal_tolerance: float = 0.17  # rad: and turned this near (aims at 0.3 of it)
+    xy_goal_tolerance: float = 0.05  # m: the goal is reached this near (the controller aims at 0.2 of it)
+    yaw_goal_tolerance: float = 0.17  # rad: and turned this near (aims at 0.2 of it)
     latch_xy_goal_tolerance: bool = False  # true: once near enough, only turn
     sim_time: float = 1.5  # s each sampled trajectory is simulated
     sim_granularity: float = 0.025  # m between checks along a trajectory
