@@ -19,6 +19,15 @@ pose, four goals around and between the pillars; a table in OUTPUT/nav.txt
 and the map with the true path, the plans and amcl's particles in
 OUTPUT/nav_paths.png. As fast as possible unless --real-time-factor says.
 
+With --explore (`make demo DEMO_ARGS="--explore"`) the robot maps
+turtlebot3_house alone (tb3_harness/exploring.py): tb3_house.launch (profile
+realistic), tb3_slam.launch explore:=true until the explore node is done,
+map_saver; then tb3_house.launch afresh and tb3_navigation.launch on the saved
+map, a 2D Pose Estimate at the spawn pose and a goal in each of four rooms. A
+line per frontier and per goal as it goes; a table in OUTPUT/explore.txt; the
+map under the house's outline with the exploration's and the navigation's true
+paths in OUTPUT/explore.png. As fast as possible unless --real-time-factor says.
+
 Run inside `source setup.bash`. Starts one master on a free loopback port, then
 for each script does what the tutorial does: start the simulator fresh
 (`roslaunch tb3_sim_bringup tb3_empty_world.launch`), wait for odom ->
@@ -42,12 +51,13 @@ import subprocess
 import sys
 import time
 
-from tb3_harness import calibration, leftovers, mapping, navigating, report
+from tb3_harness import calibration, exploring, leftovers, mapping, navigating, report
 from tb3_harness.processes import RunError, say, start_master
 from tb3_harness.tutorial import LAUNCH, SCRIPTS, run_script
 from tb3_sim_nav.robot_model import TURTLEBOT3_MODELS
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+EXPLORE_TIMEOUT = 3600.0  # wall s for the house's exploration
 _T0 = time.monotonic()
 
 
@@ -73,13 +83,17 @@ def parse_args(argv):
                         help='map turtlebot3_world (profile realistic) and save the map, instead of the tutorial')
     parser.add_argument('--nav', action='store_true',
                         help='navigate turtlebot3_world to four goals (profile realistic), instead of the tutorial')
+    parser.add_argument('--explore', action='store_true',
+                        help='map turtlebot3_house alone, save the map, navigate four rooms on it (profile realistic)')
     args = parser.parse_args(argv)
-    if args.calibrate + args.slam + args.nav > 1:
-        parser.error('--calibrate, --slam and --nav are walkthroughs of their own: one at a time')
-    if (args.slam or args.nav) and (args.scripts or args.profile not in (None, 'realistic')):
-        parser.error('--slam and --nav run their own drives in profile realistic: no --scripts, no other --profile')
+    mapping_chapters = args.slam or args.nav or args.explore
+    if args.calibrate + args.slam + args.nav + args.explore > 1:
+        parser.error('--calibrate, --slam, --nav and --explore are walkthroughs of their own: one at a time')
+    if mapping_chapters and (args.scripts or args.profile not in (None, 'realistic')):
+        parser.error('--slam, --nav and --explore run their own drives in profile realistic: no --scripts, '
+                     'no other --profile')
     if args.real_time_factor is None:
-        args.real_time_factor = 0.0 if (args.slam or args.nav) else 1.0
+        args.real_time_factor = 0.0 if mapping_chapters else 1.0
     if args.calibrate and (args.scripts or args.profile not in (None, 'realistic')):
         parser.error('--calibrate runs its own scripts in profile realistic: no --scripts, no other --profile')
     if not args.real_time_factor >= 0.0:
@@ -129,7 +143,7 @@ def main(argv=None):
     signal.signal(signal.SIGTERM, on_sigterm)
     signal.signal(signal.SIGINT, signal.default_int_handler)  # even if started with SIGINT ignored
 
-    calibrated = mapped = navigated = None
+    calibrated = mapped = navigated = explored = None
     scripts = [(name, expected) for name, expected in SCRIPTS if not args.scripts or name in args.scripts]
     master = None
     results, failures = [], []
@@ -148,7 +162,15 @@ def main(argv=None):
             mapped = mapping.map_world(log_dir, args.output, factor=args.real_time_factor)
         if args.nav:
             navigated = navigating.navigate_world(log_dir, factor=args.real_time_factor)
-        for script, expected in scripts if not (args.calibrate or args.slam or args.nav) else ():
+        if args.explore:
+            launch, start, slam_args = exploring.WORLDS['turtlebot3_house']
+            explored = exploring.explore_world(log_dir, args.output, 'turtlebot3_house', launch, start,
+                                               factor=args.real_time_factor, timeout=EXPLORE_TIMEOUT,
+                                               slam_command=exploring.SLAM_COMMAND + list(slam_args))
+            navigated = navigating.navigate_world(log_dir, factor=args.real_time_factor, world='turtlebot3_house',
+                                                  launch='tb3_house.launch', map_file=explored.map_yaml,
+                                                  goals=navigating.HOUSE_GOALS, spawn=navigating.HOUSE_SPAWN)
+        for script, expected in scripts if not (args.calibrate or args.slam or args.nav or args.explore) else ():
             result, error = run_script(script, expected, args, log_dir)
             results.append(result)
             if error:
@@ -180,7 +202,16 @@ def main(argv=None):
         mapping.draw(mapped, os.path.join(args.output, 'slam_map.png'))
         say('wrote %s, %s and %s' % (mapped.map_yaml, os.path.join(args.output, 'slam.txt'),
                                      os.path.join(args.output, 'slam_map.png')))
-    if navigated is not None:
+    if explored is not None and navigated is not None:
+        text = '\n'.join(exploring.table(explored) + [''] + navigating.table(navigated)
+                         + ['', 'total wall time %.1f s' % total])
+        print('\n' + text, flush=True)
+        with open(os.path.join(args.output, 'explore.txt'), 'w') as summary:
+            summary.write(text + '\n')
+        exploring.draw(explored, os.path.join(args.output, 'explore.png'), navigated.truth)
+        say('wrote %s, %s and %s' % (explored.map_yaml, os.path.join(args.output, 'explore.txt'),
+                                     os.path.join(args.output, 'explore.png')))
+    elif navigated is not None:
         text = '\n'.join(navigating.table(navigated) + ['', 'total wall time %.1f s' % total])
         print('\n' + text, flush=True)
         with open(os.path.join(args.output, 'nav.txt'), 'w') as summary:

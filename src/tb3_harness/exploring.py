@@ -29,6 +29,7 @@ BURGER_FOOTPRINT = [(-0.105, -0.105), (-0.105, 0.105), (0.041, 0.105), (0.041, -
 DONE = re.compile(r'\[([0-9.]+) s\] exploration done: (.*?)\. Explored ([0-9.]+) m2 free and ([0-9.]+) m2 occupied, '
                   r'([0-9]+) % .*?; ([0-9]+) goals sent in ([0-9.]+) s, ([0-9]+) blacklisted')
 GOAL = re.compile(r'explore: \[([0-9.]+) s\] goal ([0-9]+) \(')
+GOAL_LINE = re.compile(r'explore: (\[[0-9.]+ s\] goal [0-9]+ .*)')
 
 
 @dataclasses.dataclass
@@ -71,10 +72,17 @@ def progress(log_text):
     return len(goals), float(goals[-1][0]) if goals else math.nan, DONE.search(log_text)
 
 
+#: The SLAM with exploration, as the walkthrough has it but without rviz.
+SLAM_COMMAND = ['roslaunch', 'tb3_sim_bringup', 'tb3_slam.launch', 'explore:=true', 'open_rviz:=false']
+
+
 def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.launch', start=(-2.0, -0.5),
-                  factor=0.0, profile='realistic', seed=7, timeout=900.0, launch_args=(), say_every=60.0):
+                  factor=0.0, profile='realistic', seed=7, timeout=900.0, launch_args=(), say_every=60.0,
+                  slam_command=SLAM_COMMAND, when_saved=None):
     """One exploration (see the module's doc); its ExplorationRun. RunError if a step fails or the
-    explore node is not done within `timeout` wall s. `start`: the spawn (x, y) of `launch`."""
+    explore node is not done within `timeout` wall s. `start`: the spawn (x, y) of `launch`;
+    `slam_command`: the argv that starts the SLAM and the explorer (a test types the README's
+    through bash); `when_saved()` is called once the map is saved, before anything is stopped."""
     import rosgraph
     import rospkg
     from tb3_navigation.map_files import load_map
@@ -97,20 +105,24 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
         sim = spawn('sim', ['roslaunch', 'tb3_sim_bringup', launch, 'profile:=%s' % profile,
                             'real_time_factor:=%g' % factor] + list(launch_args))
         recorder = spawn('recorder', ['python3', '-m', 'tb3_harness.pose_recorder', '--out', path_file])
-        slam = spawn('slam', ['roslaunch', 'tb3_sim_bringup', 'tb3_slam.launch', 'explore:=true',
-                              'open_rviz:=false'])
+        slam = spawn('slam', list(slam_command))
         wait_until(lambda: 'connected to move_base' in _read(slam.log), READY_TIMEOUT, 'explore node',
                    watch=(sim, slam, recorder))
         say('exploring %s at factor %g' % (world, factor))
-        told = time.monotonic()
+        told, shown = time.monotonic(), 0
 
         def done():
-            nonlocal told
-            goals, last, match = progress(_read(slam.log))
+            nonlocal told, shown
+            text = _read(slam.log)
+            lines = GOAL_LINE.findall(text)
+            for line in lines[shown:]:  # a line per goal: sim time, frontier, area mapped so far
+                say('%s: %s' % (world, line))
+            shown = len(lines)
             if time.monotonic() - told > say_every:
                 told = time.monotonic()
+                goals, last, _ = progress(text)
                 say('exploring %s: %d goals so far, the last at %.1f s of sim time' % (world, goals, last))
-            return match is not None
+            return DONE.search(text) is not None
         wait_until(done, timeout, 'end of the exploration ("exploration done" in %s)' % slam.log, poll=1.0,
                    watch=(sim, slam, recorder))
         wall = time.monotonic() - wall_start
@@ -119,6 +131,8 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
         if saver.wait(SAVE_TIMEOUT) != 0:
             raise RunError('map_saver did not save the map (exit %s): %s' % (saver.popen.returncode, tail(saver.log)))
         say('%s explored: %s' % (world, match.group(0)))
+        if when_saved is not None:
+            when_saved()
     finally:
         for process in reversed(started):
             process.stop()
@@ -134,19 +148,39 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
                           clearance(truth, obstacles, BURGER_FOOTPRINT), saved.grid, saved.values)
 
 
-#: The worlds explored from their launch's spawn pose: launch, spawn (x, y).
-WORLDS = {'turtlebot3_world': ('tb3_world.launch', (-2.0, -0.5)),
-          'turtlebot3_house': ('tb3_house.launch', (-3.0, 1.0))}
+#: The worlds explored from their launch's spawn pose: launch, spawn (x, y), the SLAM's launch args.
+#: turtlebot3_house is open to a yard on its south side: explore_bounds keeps the goals in the house's
+#: box (the yard took 400 s more, and walls mapped from outside and inside came out doubled).
+HOUSE_BOUNDS = '[-7.6,-5.4,7.6,5.4]'
+WORLDS = {'turtlebot3_world': ('tb3_world.launch', (-2.0, -0.5), ()),
+          'turtlebot3_house': ('tb3_house.launch', (-3.0, 1.0), ('explore_bounds:=' + HOUSE_BOUNDS,))}
 
 
-def draw(run, filename):
-    """The saved map under the world's outline, with the true path."""
+def table(run):
+    """The exploration's figures, for the demo's table."""
+    quality = run.quality
+    return ['%s explored alone by tb3_slam.launch explore:=true (profile realistic), real_time_factor %g'
+            % (run.world, run.factor),
+            '  ended: %s' % run.done_text,
+            '  %d goals sent, %d blacklisted, in %.1f s of sim time (%.1f s wall)'
+            % (run.goals, run.blacklisted, run.sim_seconds, run.wall_seconds),
+            '  reachable free floor mapped as free: %.1f %%' % (100 * quality.free_floor_mapped),
+            '  occupied cells on a surface of the world: %.1f %%; surfaces covered: %.1f %%; walls %.1f cells thick'
+            % (100 * quality.occupied_near_surface, 100 * quality.surface_covered, quality.wall_thickness),
+            '  footprint never nearer than %.3f m to the world' % run.clearance,
+            '  map saved: %s' % run.map_yaml]
+
+
+def draw(run, filename, navigation_path=None):
+    """The saved map under the world's outline, with the true path (and a navigation's after it)."""
     import rospkg
     from tb3_sim_nav.world_file import load_world
     from .map_quality import render_png
     worlds = os.path.join(rospkg.RosPack().get_path('tb3_sim_nav'), 'worlds')
-    render_png(filename, run.grid, run.values, load_world(run.world, worlds).obstacles,
-               paths={'true path': [p[1:3] for p in run.truth]},
+    paths = {'exploration path': [p[1:3] for p in run.truth]}
+    if navigation_path:
+        paths['navigation path'] = [p[1:3] for p in navigation_path]
+    render_png(filename, run.grid, run.values, load_world(run.world, worlds).obstacles, paths=paths,
                title='%s explored alone: %.0f %% of the reachable free floor mapped, %.0f s of sim time, %d goals'
                      % (run.world, 100 * run.quality.free_floor_mapped, run.sim_seconds, run.goals))
 
@@ -163,10 +197,11 @@ def main(argv=None):
     args = parser.parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
     os.environ.setdefault('TURTLEBOT3_MODEL', 'burger')
-    launch, start = WORLDS[args.world]
+    launch, start, slam_args = WORLDS[args.world]
     master = start_master(args.out)
     try:
-        run = explore_world(args.out, args.out, world=args.world, launch=launch, start=start, timeout=args.timeout)
+        run = explore_world(args.out, args.out, world=args.world, launch=launch, start=start, timeout=args.timeout,
+                            slam_command=SLAM_COMMAND + list(slam_args))
     finally:
         master.stop()
     draw(run, os.path.join(args.out, 'exploration.png'))

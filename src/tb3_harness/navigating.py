@@ -204,6 +204,10 @@ def closest(path, obstacles, footprint):
 WORLD_SPAWN = (-2.0, -0.5, 0.0)
 WORLD_GOALS = [(-0.55, -0.55, 0.0), (0.55, 0.55, math.pi / 2), (1.65, -0.55, -math.pi / 2), (-0.55, 1.65, math.pi)]
 BURGER_FOOTPRINT = [(-0.105, -0.105), (-0.105, 0.105), (0.041, 0.105), (0.041, -0.105)]
+#: The explore demo's goals in turtlebot3_house, one in each of four rooms, from tb3_house's spawn:
+#: the small west room, the room inside the north-east one, the north-east room, the south-east room.
+HOUSE_SPAWN = (-3.0, 1.0, 0.0)
+HOUSE_GOALS = [(-6.5, -1.5, -math.pi / 2), (1.0, 3.0, math.pi / 2), (4.0, 1.0, 0.0), (5.6, -2.0, -math.pi / 2)]
 
 
 @dataclasses.dataclass
@@ -211,6 +215,8 @@ class NavigationRun(object):
     """One run of the navigation chapter: each goal's Outcome, the map, the recordings, and what it cost
     (CPU shares of a core: amcl and move_base together, the simulator; wall and sim seconds of the goals)."""
     factor: float
+    world: str
+    map_file: str
     outcomes: list
     grid: object
     values: object
@@ -226,10 +232,11 @@ class NavigationRun(object):
     closest: tuple  # the true pose [t, x, y, yaw] where the footprint came closest
 
 
-def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD_GOALS, spawn=WORLD_SPAWN):
-    """tb3_world.launch and tb3_navigation.launch (its shipped map), a 2D Pose Estimate at the spawn
-    pose, then `goals` one after the other; the caller is a rospy node (following /clock) of a master
-    of its own. RunError if a launch fails."""
+def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD_GOALS, spawn=WORLD_SPAWN,
+                   world='turtlebot3_world', launch='tb3_world.launch', map_file=None):
+    """`launch` (tb3_world.launch) and tb3_navigation.launch on `map_file` (None: the world's
+    shipped map), a 2D Pose Estimate at the spawn pose, then `goals` one after the other; the caller
+    is a rospy node (following /clock) of a master of its own. RunError if a launch fails."""
     import rosgraph
     import rospkg
     import rospy
@@ -241,12 +248,13 @@ def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD
     rosgraph.Master('/tb3_harness').setParam('/tb3_sim/seed', seed)
     rosgraph.Master('/tb3_harness').setParam('/amcl/seed', seed)
     package = rospkg.RosPack().get_path('tb3_sim_nav')
+    map_file = map_file or os.path.join(package, 'maps', world + '.yaml')
     started = []
     try:
-        started.append(Process('sim', ['roslaunch', 'tb3_sim_bringup', 'tb3_world.launch', 'profile:=%s' % profile,
+        started.append(Process('sim', ['roslaunch', 'tb3_sim_bringup', launch, 'profile:=%s' % profile,
                                        'real_time_factor:=%g' % factor], log_dir, die_with_parent=True))
-        started.append(Process('nav', ['roslaunch', 'tb3_sim_bringup', 'tb3_navigation.launch', 'open_rviz:=false'],
-                               log_dir, die_with_parent=True))
+        started.append(Process('nav', ['roslaunch', 'tb3_sim_bringup', 'tb3_navigation.launch', 'open_rviz:=false',
+                                       'map_file:=%s' % map_file], log_dir, die_with_parent=True))
         wait_until(lambda: started[1].output(20000).count('map of') >= 2, 60.0, 'the map in amcl and move_base',
                    watch=started)
         navigation = Navigation()
@@ -266,10 +274,10 @@ def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD
     finally:
         for process in reversed(started):
             process.stop()
-    saved = load_map(os.path.join(package, 'maps', 'turtlebot3_world.yaml'))
-    obstacles = load_world('turtlebot3_world', os.path.join(package, 'worlds')).obstacles
+    saved = load_map(map_file)
+    obstacles = load_world(world, os.path.join(package, 'worlds')).obstacles
     truth = list(navigation.truth)
-    return NavigationRun(factor, outcomes, saved.grid, saved.values, truth, list(navigation.plans),
+    return NavigationRun(factor, world, map_file, outcomes, saved.grid, saved.values, truth, list(navigation.plans),
                          list(navigation.clouds), list(navigation.spreads), (used[0] + used[1]) / wall,
                          used[2] / wall, wall, sim, *closest(truth, obstacles, BURGER_FOOTPRINT))
 
@@ -282,8 +290,8 @@ def say_goal(number, outcome):
 
 
 def table(run):
-    lines = ['turtlebot3_world navigated by tb3_navigation.launch (profile realistic, shipped map, 2D Pose '
-             'Estimate at the spawn pose), real_time_factor %g' % run.factor,
+    lines = ['%s navigated by tb3_navigation.launch (profile realistic, map %s, 2D Pose '
+             'Estimate at the spawn pose), real_time_factor %g' % (run.world, run.map_file, run.factor),
              '  goal (x, y, yaw)         outcome    sim s   true error (m, rad)']
     for outcome in run.outcomes:
         lines.append('  (%5.2f, %5.2f, %5.2f)   %-9s  %5.1f   %.3f, %.3f' % (
@@ -309,7 +317,7 @@ def draw(run, filename):
     for index, (_, plan) in enumerate(run.plans[::max(1, len(run.plans) // 4)][:4]):
         paths['plan %d' % (index + 1)] = plan
     clouds = dict(('particles at %.0f s' % stamp, points) for stamp, points in run.clouds[:3])
-    render_png(filename, run.grid, run.values, load_world('turtlebot3_world', os.path.join(package, 'worlds')).obstacles,
+    render_png(filename, run.grid, run.values, load_world(run.world, os.path.join(package, 'worlds')).obstacles,
                paths=paths, clouds=clouds,
-               title='turtlebot3_world navigated (profile realistic): %d of %d goals SUCCEEDED'
-                     % (sum(o.state == 'SUCCEEDED' for o in run.outcomes), len(run.outcomes)))
+               title='%s navigated (profile realistic): %d of %d goals SUCCEEDED'
+                     % (run.world, sum(o.state == 'SUCCEEDED' for o in run.outcomes), len(run.outcomes)))

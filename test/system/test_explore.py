@@ -1,11 +1,13 @@
 """A robot that maps a world by itself (issue 21), judged against the world file.
 
 `roslaunch tb3_sim_bringup tb3_world.launch profile:=realistic real_time_factor:=0`,
-`roslaunch tb3_sim_bringup tb3_slam.launch explore:=true open_rviz:=false`, until
-the explore node says it is done, then `rosrun map_server map_saver -f`, all
-through tb3_harness.exploring (the demo runs it too): the reachable free
-floor mapped as free (goal >= 90 %), the map as precise as the SLAM test
-wants it, and the footprint never touching the world on the true path.
+then the README's `roslaunch tb3_sim_bringup tb3_slam.launch explore:=true`
+through bash, rviz on a screen of the test's own, until the explore node says
+it is done, then `rosrun map_server map_saver -f`, all through
+tb3_harness.exploring (the demo runs it too): the reachable free floor mapped
+as free (goal >= 90 %), the map as precise as the SLAM test wants it, and the
+footprint never touching the world on the true path. rviz's last picture goes
+to ~/.ros/test_results/tb3_sim_nav/emanual/explore.png (doc/'s is a copy).
 
 Then the bad cases: a robot boxed in ends at once with a clear message and
 then sits idle; a move_base that aborts every goal makes the explorer
@@ -19,6 +21,9 @@ from tb3_harness import exploring
 from tb3_harness.mapping import _node_pid
 from tb3_harness.measure import cpu_seconds
 from tb3_harness.processes import Process, start_master, wait_until
+from tb3_harness.screen import save_png, screenshot, start_xvfb
+
+from test_emanual import FLOOR, SHOTS, WALL, colour_pixels, map_view
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 BOXED_IN = os.path.join(HERE, '..', 'data', 'worlds', 'boxed_in.yaml')
@@ -41,14 +46,29 @@ def _idle_after_done(log, pid):
     return _read(log).count('explore: [') - before, (cpu_seconds(pid) - cpu) / IDLE_WATCH
 
 
-def test_exploration_maps_turtlebot3_world_alone(tmp_path):
+def test_exploration_maps_turtlebot3_world_alone(tmp_path, monkeypatch):
     folder = str(tmp_path)
-    os.environ['TURTLEBOT3_MODEL'] = 'burger'
+    monkeypatch.setenv('TURTLEBOT3_MODEL', 'burger')
     master = start_master(folder)
+    xvfb, display = start_xvfb()
+    monkeypatch.setenv('DISPLAY', display)
+    pictures = []
+
+    def picture():
+        image = screenshot(display)
+        os.makedirs(SHOTS, exist_ok=True)
+        save_png(image, os.path.join(SHOTS, 'explore.png'))
+        pictures.append(image)
     try:
-        run = exploring.explore_world(folder, folder, timeout=WORLD_TIMEOUT)
+        run = exploring.explore_world(folder, folder, timeout=WORLD_TIMEOUT, when_saved=picture, slam_command=[
+            'bash', '-c', 'roslaunch tb3_sim_bringup tb3_slam.launch explore:=true'])
     finally:
         master.stop()
+        xvfb.stop()
+    view = map_view(pictures[0])
+    walls, floor = colour_pixels(view, WALL, 8), colour_pixels(view, FLOOR, 8)
+    print('MEASURED rviz after exploring: %d wall pixels, %d floor pixels' % (walls, floor))
+    assert walls > 2000 and floor > 20000  # the map, shown in rviz
     quality = run.quality
     print('MEASURED %s' % run.summary())
     assert 'no frontier' in run.done_text and 'boxed in' not in run.done_text, run.done_text

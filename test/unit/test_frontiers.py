@@ -10,7 +10,7 @@ from scipy import ndimage
 
 from tb3_navigation.costmap import Costmap, CostmapConfig
 from tb3_navigation.exploration import ABORTED, DONE, KEEP, SEND, SUCCEEDED, WAIT, Explorer
-from tb3_navigation.frontiers import (BLACKLISTED, CANDIDATE, IN_THE_OPEN, NO_ROOM, TOO_SMALL, UNREACHABLE,
+from tb3_navigation.frontiers import (BLACKLISTED, CANDIDATE, IN_THE_OPEN, NO_ROOM, OUTSIDE, TOO_SMALL, UNREACHABLE,
                                       ExploreConfig, FrontierSearch, explored_area, frontier_cells, label_frontiers)
 from tb3_navigation.grid import Grid
 from tb3_navigation.occupancy import OccupancyGrid
@@ -211,6 +211,21 @@ def test_a_frontier_far_from_every_wall_is_in_the_open():
     assert FrontierSearch(ExploreConfig(max_wall_distance=0.0)).search(grid, values, (1.0, 1.5, 0.0)).best
     values[-1, 140:150] = 100  # a piece of wall seen 1 m before the frontier
     assert FrontierSearch().search(grid, values, (1.0, 1.5, 0.0)).best is not None
+
+
+def test_a_frontier_outside_explore_bounds_is_not_chosen():
+    """A 3 x 1 m room seen up to x = 1.5 m: with explore_bounds ending at x = 1.2 m its frontier
+    (x = 1.475 m) is outside and exploration is over; bounds reaching past it change nothing."""
+    grid, values = room(3.0, 1.0, unknown_from=1.5)
+    robot = (0.25, 0.5, 0.0)
+    outside = FrontierSearch(ExploreConfig(explore_bounds=(-1.0, -1.0, 1.2, 2.0))).search(grid, values, robot)
+    assert outside.best is None and outside.frontiers[0].status == OUTSIDE
+    assert 'outside explore_bounds' in outside.why_none()
+    inside = FrontierSearch(ExploreConfig(explore_bounds=(-1.0, -1.0, 2.0, 2.0))).search(grid, values, robot)
+    assert inside.best.goal == FrontierSearch().search(grid, values, robot).best.goal
+    for bounds in ((0.0, 0.0, 1.0), (1.0, 0.0, 0.0, 1.0), (0.0, 0.0, float('inf'), 1.0)):
+        with pytest.raises(ValueError, match='explore_bounds'):
+            ExploreConfig(explore_bounds=bounds)
 
 
 def test_the_blacklist_rules_out_goals_within_its_radius():

@@ -40,7 +40,9 @@ with no cell where the footprint fits has no room (a wall the map shows
 with gaps, seen at a grazing angle, borders unknown space all along); one
 whose roomy cells no plan reaches is unreachable; one whose reachable cells
 all lie farther than max_wall_distance from every wall of the map is in the
-open; one whose remaining cells all lie within blacklist_radius of a
+open; one whose remaining cells all lie outside explore_bounds (ours, as
+frontier_exploration's boundary polygon, a box here) is outside; one
+whose remaining cells all lie within blacklist_radius of a
 blacklisted goal is blacklisted. The rest are candidates, cheapest first;
 none left: exploration is done.
 
@@ -64,8 +66,8 @@ from .grid import Grid
 from .grid_graph import path_to
 from .planner import GlobalPlanner, PlannerConfig
 
-CANDIDATE, TOO_SMALL, NO_ROOM, UNREACHABLE, IN_THE_OPEN, BLACKLISTED = (
-    'candidate', 'too small', 'no room', 'unreachable', 'in the open', 'blacklisted')
+CANDIDATE, TOO_SMALL, NO_ROOM, UNREACHABLE, IN_THE_OPEN, OUTSIDE, BLACKLISTED = (
+    'candidate', 'too small', 'no room', 'unreachable', 'in the open', 'outside', 'blacklisted')
 FOUR = ndimage.generate_binary_structure(2, 1)
 EIGHT = ndimage.generate_binary_structure(2, 2)
 HEADING_BACK = 0.3  # m: the goal faces the way the path comes in over its last 0.3 m
@@ -85,6 +87,7 @@ class ExploreConfig:
     min_frontier_size: float = 0.5
     blacklist_radius: float = 0.25
     max_wall_distance: float = 2.5
+    explore_bounds: tuple = ()  # (xmin, ymin, xmax, ymax) in the map: no goal outside; (): anywhere
 
     def __post_init__(self):
         for name in ('planner_frequency', 'progress_timeout', 'potential_scale', 'orientation_scale', 'gain_scale',
@@ -95,6 +98,12 @@ class ExploreConfig:
                 raise ValueError('%s must be a finite number >= 0, not %r' % (name, value))
         if not self.planner_frequency > 0:
             raise ValueError('planner_frequency must be > 0, not %r' % (self.planner_frequency,))
+        bounds = self.explore_bounds
+        if bounds != () and not (len(bounds) == 4 and all(
+                isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+                for value in bounds) and bounds[0] < bounds[2] and bounds[1] < bounds[3]):
+            raise ValueError('explore_bounds must be [] or [xmin, ymin, xmax, ymax] with xmin < xmax and '
+                             'ymin < ymax, not %r' % (bounds,))
 
 
 @dataclass(frozen=True)
@@ -137,6 +146,7 @@ class Search:
         parts = []
         for status, words in ((UNREACHABLE, 'out of the planner\'s reach'), (BLACKLISTED, 'blacklisted'),
                               (IN_THE_OPEN, 'in the open, farther than max_wall_distance from any wall'),
+                              (OUTSIDE, 'outside explore_bounds'),
                               (NO_ROOM, 'with no cell where the robot fits'),
                               (TOO_SMALL, 'smaller than min_frontier_size')):
             frontiers = [frontier for frontier in self.frontiers if frontier.status == status]
@@ -187,6 +197,13 @@ class FrontierSearch(object):
         distance = ndimage.distance_transform_edt(~walls) * costmap.grid.resolution
         return distance <= self.config.max_wall_distance
 
+    def within_bounds(self, points):
+        """True at the points (n, 2) inside explore_bounds (all, without bounds)."""
+        if not self.config.explore_bounds:
+            return np.ones(len(points), dtype=bool)
+        xmin, ymin, xmax, ymax = self.config.explore_bounds
+        return (points[:, 0] >= xmin) & (points[:, 0] <= xmax) & (points[:, 1] >= ymin) & (points[:, 1] <= ymax)
+
     def search(self, grid, values, robot_pose, blacklist=()):
         """The Search of the map `values` [iy, ix] on `grid` for a robot at `robot_pose` (x, y, yaw),
         goals within blacklist_radius of a point of `blacklist` [(x, y)] ruled out."""
@@ -216,12 +233,13 @@ class FrontierSearch(object):
                 continue
             roomy = costs[cells[:, 1], cells[:, 0]] <= room
             reachable = roomy & np.isfinite(potential[cells[:, 1], cells[:, 0]])
-            in_view = reachable & walled[cells[:, 1], cells[:, 0]]
+            near = reachable & walled[cells[:, 1], cells[:, 0]]
+            in_view = near & self.within_bounds(points)
             allowed = in_view & _away_from(points, blacklist, config.blacklist_radius)
             open_cells = cells[allowed]
             if not len(open_cells):
-                status = (BLACKLISTED if in_view.any() else IN_THE_OPEN if reachable.any() else
-                          UNREACHABLE if roomy.any() else NO_ROOM)
+                status = (BLACKLISTED if in_view.any() else OUTSIDE if near.any() else
+                          IN_THE_OPEN if reachable.any() else UNREACHABLE if roomy.any() else NO_ROOM)
                 frontiers.append(Frontier(points, size, centroid, status))
                 continue
             best = open_cells[np.argmin(potential[open_cells[:, 1], open_cells[:, 0]])]
