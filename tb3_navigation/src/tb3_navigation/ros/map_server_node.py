@@ -2,7 +2,8 @@
 
 Publishes the map latched on `map` and its MapMetaData on `map_metadata`,
 answers `static_map` (nav_msgs/GetMap) with it and loads another on
-`change_map` (nav_msgs/LoadMap). `~frame_id` (default map) is the map's
+`change_map` (nav_msgs/LoadMap). `~frame_id` (default map; in a namespace
+NAMESPACE/map, as this project's other nodes name frames there) is the map's
 frame. The node is anonymous, as the original (map_server_<pid>_<time>), so
 several can serve maps on remapped topics. A map that cannot be read ends
 the node at start-up with one line naming the file and the key and exit
@@ -19,6 +20,7 @@ from nav_msgs.srv import GetMap, GetMapResponse, LoadMap, LoadMapResponse
 
 from .. import map_files
 from . import lifecycle
+from .frames import namespaced
 from .map_messages import occupancy_grid
 
 USAGE = ('\nUSAGE: map_server <map.yaml>\n'
@@ -117,7 +119,7 @@ def main(argv=None):
         sys.stderr.write('[ERROR] %s\n' % USAGE)
         sys.exit(EXIT_FAILURE)
     life = lifecycle.init_node('map_server', anonymous=True)
-    server = MapServer(life, rospy.get_param('~frame_id', 'map'))
+    server = MapServer(life, rospy.get_param('~frame_id', namespaced('map', rospy.get_namespace())))
     try:
         server.serve(_load(arguments))
     except map_files.MapFileError as error:
