@@ -15,7 +15,7 @@ import statistics
 import sys
 import time
 
-from tb3_harness import leftovers, report, tutorial
+from tb3_harness import leftovers, mapping, navigating, report, tutorial
 from tb3_harness.measure import cpu_seconds, machine, memory_mib, sim_pid, sim_uri
 from tb3_harness.processes import Process, RunError, say, start_master, wait_until
 from tb3_harness.screen import start_xvfb
@@ -318,15 +318,41 @@ def verdict(ok):
     return 'met' if ok else 'MISSED'
 
 
+def nav_rows(mapped, navigated):
+    """The mapping and navigation chapters' rows: one run each at factor 1 and as fast as possible."""
+    slam_1, slam_0, nav_1, nav_0 = mapped[1.0], mapped[0.0], navigated[1.0], navigated[0.0]
+    reached = ['%d/%d' % (sum(o.state == 'SUCCEEDED' for o in run.outcomes), len(run.outcomes))
+               for run in (nav_1, nav_0)]
+    worst = max(o.xy_error for o in nav_1.outcomes + nav_0.outcomes)
+    return ['SLAM (tb3_slam.launch) round turtlebot3_world\'s pillars, profile realistic, one run each:',
+            '%-58s %11.1f%%' % ('  CPU of the SLAM node at factor 1 while driving', 100 * slam_1.slam_cpu),
+            '%-58s %12.1f' % ('  real-time factor reached with it, as fast as possible',
+                              slam_0.sim_seconds / slam_0.wall_seconds),
+            '%-58s %7.1f / %.1f cm' % ('  pose in map at the end, factor 1 / 0 (odometry: %.1f cm)'
+                                       % (100 * slam_1.odom_error[0]), 100 * slam_1.map_error[0],
+                                       100 * slam_0.map_error[0]),
+            '%-58s %5.1f / %.1f %%' % ('  occupied cells on a surface of the world, factor 1 / 0',
+                                      100 * slam_1.quality.occupied_near_surface,
+                                      100 * slam_0.quality.occupied_near_surface),
+            'navigation (tb3_navigation.launch: amcl and move_base), four goals in turtlebot3_world:',
+            '%-58s %11.1f%%' % ('  CPU of amcl and move_base at factor 1 while driving', 100 * nav_1.stack_cpu),
+            '%-58s %12.1f' % ('  real-time factor reached with them, as fast as possible',
+                              nav_0.sim_seconds / nav_0.wall_seconds),
+            '%-58s %12s' % ('  goals reached, factor 1 / 0', ' / '.join(reached)),
+            '%-58s %10.1f cm' % ('  worst true distance from a goal reached', 100 * worst)]
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--runs', type=int, default=3, help='runs per figure (median reported)')
     parser.add_argument('--seconds', type=float, default=10.0, help='wall s per real-time-factor run')
     parser.add_argument('--cpu-seconds', type=float, default=30.0, help='wall s of the CPU measurement')
-    parser.add_argument('--parts', default='rtf,cpu,floor,camera,scripts',
+    parser.add_argument('--parts', default='rtf,cpu,floor,camera,scripts,nav',
                         help='comma-separated: rtf (max real-time factor), cpu (CPU, memory, start-up), '
                              'floor (CPU of a bare /clock loop, for scale), camera (frame costs, real time '
-                             'with a camera read), scripts (the tutorial scripts at factor 1 and 0); default all')
+                             'with a camera read), scripts (the tutorial scripts at factor 1 and 0), nav (the '
+                             'SLAM and the navigation stack at factor 1 and as fast as possible, once each); '
+                             'default all')
     parser.add_argument('--output', default=os.path.join(ROOT, 'bench_output'))
     args = parser.parse_args(argv)
     log_dir = os.path.join(args.output, 'logs')
@@ -374,6 +400,17 @@ def main(argv=None):
         if 'scripts' in parts:
             for factor in (1.0, 0.0):
                 scripts[factor] = run_scripts(log_dir, factor)
+        mapped, navigated = {}, {}
+        for factor in ((1.0, 0.0) if 'nav' in parts else ()):
+            folder = os.path.join(args.output, 'map_at_factor_%g' % factor)
+            os.makedirs(folder, exist_ok=True)
+            mapped[factor] = mapping.map_world(log_dir, folder, factor=factor)
+            say('SLAM at factor %g: %.1f s of sim time in %.1f s wall, the SLAM %.0f %% of a core' % (
+                factor, mapped[factor].sim_seconds, mapped[factor].wall_seconds, 100 * mapped[factor].slam_cpu))
+            navigated[factor] = navigating.navigate_world(log_dir, factor=factor)
+            say('navigation at factor %g: %.1f s of sim time in %.1f s wall, amcl and move_base %.0f %% of a core'
+                % (factor, navigated[factor].sim_seconds, navigated[factor].wall_seconds,
+                   100 * navigated[factor].stack_cpu))
 
         lines += ['tb3_sim_nav benchmark, %s' % datetime.date.today().isoformat(),
                   'machine: %s' % machine(),
@@ -423,6 +460,8 @@ def main(argv=None):
                       '%-58s %6.3f m %5.2f deg  (ends %+.3f %+.3f %+.1f deg / %+.3f %+.3f %+.1f deg)'
                       % ('  end pose, factor 0 against factor 1', apart, turn,
                          end_1[1], end_1[2], math.degrees(end_1[3]), end_0[1], end_0[2], math.degrees(end_0[3]))]
+        if mapped:
+            lines += nav_rows(mapped, navigated)
     except RunError as error:
         print('bench FAILED: %s' % error, file=sys.stderr)
         return 1

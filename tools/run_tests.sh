@@ -91,6 +91,12 @@ part 1 test_known_worlds "$pytest test/system/test_known_worlds.py"
 part 1 test_calibration "$pytest test/system/test_calibration.py -k 'not make_demo and not busy_core'"
 part 1 test_bad_startup "$pytest test/system/test_bad_startup.py"
 part 1 test_master_restart "$pytest test/system/test_master_restart.py"
+# Mapping and navigation: the SLAM, amcl and move_base keep a core busy (most run as fast as possible).
+part 2 test_explore "$pytest test/system/test_explore.py"
+part 2 test_navigation "$pytest test/system/test_navigation.py"
+part 2 test_slam "$pytest test/system/test_slam.py"
+part 2 test_emanual "$pytest test/system/test_emanual.py"
+part 2 test_multi_robot_maps "$pytest test/system/test_multi_robot_maps.py"
 # Every other system-test file, whole.
 for test_file in test/system/test_*.py; do
   name=$(basename "$test_file" .py)
