@@ -128,7 +128,7 @@ def test_at_the_goal_it_stops_then_turns_in_place_then_holds():
     _, controller = open_field(config)
     plan = straight_plan(0.5, 0.0)
     plan[-1, 2] = math.pi / 2  # the goal's yaw
-    at_goal = (0.5 - 0.005, 0.0, 0.0)  # within ARRIVAL (0.2) of xy_goal_tolerance: the approach is over
+    at_goal = (0.5 - 0.005, 0.0, 0.0)  # within ARRIVAL (0.3) of xy_goal_tolerance: the approach is over
     command = controller.compute(at_goal, (0.2, 0.0), plan)  # still moving: slow down first
     assert command.ok and command.w == 0.0 and command.v == pytest.approx(0.0)
     assert not controller.is_goal_reached(at_goal, (0.2, 0.0), plan)

@@ -42,8 +42,8 @@ EPSILON = 1e-4  # m/s, rad/s: SimpleTrajectoryGenerator's slack on the velocity 
 #: tolerance, or within PASSED of it once the robot drives away from the goal again (it went by:
 #: turning back would only oscillate), and the goal counts as reached only once the turn in place
 #: has brought the heading within ARRIVAL of the yaw tolerance.
-ARRIVAL = 0.2
-PASSED = 0.4
+ARRIVAL = 0.3
+PASSED = 0.5
 
 
 @dataclass(frozen=True)
@@ -61,8 +61,8 @@ class DwaConfig:
     acc_lim_x: float = 2.5  # m/s^2
     acc_lim_y: float = 0.0  # a differential base: 0
     acc_lim_theta: float = 3.2  # rad/s^2
-    xy_goal_tolerance: float = 0.05  # m: the goal is reached this near (the controller aims at 0.2 of it)
-    yaw_goal_tolerance: float = 0.17  # rad: and turned this near (aims at 0.2 of it)
+    xy_goal_tolerance: float = 0.05  # m: the goal is reached this near (the controller aims at 0.3 of it)
+    yaw_goal_tolerance: float = 0.17  # rad: and turned this near (aims at 0.3 of it)
     latch_xy_goal_tolerance: bool = False  # true: once near enough, only turn
     sim_time: float = 1.5  # s each sampled trajectory is simulated
     sim_granularity: float = 0.025  # m between checks along a trajectory
@@ -74,7 +74,7 @@ class DwaConfig:
     path_distance_bias: float = 32.0  # weight of staying on the global plan
     goal_distance_bias: float = 20.0  # weight of getting to the local goal
     occdist_scale: float = 0.02  # weight of keeping off obstacles
-    obstacle_clearance: float = 0.1  # m (ours): trajectories keep this far from obstacles whenever one can
+    obstacle_clearance: float = 0.12  # m (ours): trajectories keep this far from obstacles whenever one can
     forward_point_distance: float = 0.325  # m: the point ahead scored too
     stop_time_buffer: float = 0.2  # s: a trajectory must stop this long before an obstacle
     scaling_speed: float = 0.25  # m/s: above it the footprint is scaled up

@@ -35,11 +35,11 @@ Where this differs from amcl, and why:
   and moves the mean less than 0.1 m and 0.1 rad; else the mean itself
   (refine_estimate false: always). With TurtleBot3's flat beam model
   (sigma_hit 0.2, z_rand 0.5) the cloud is a few cm wide and its mean
-  wanders in it: on the loop round turtlebot3_world's pillars (6 seeds,
-  shipped map, rviz's initial covariance; after the first quarter) the mean
-  was median 1.4, p95 3.6, worst 4.9 cm off the truth, and a robot stopping
-  on it ended up to 6.5 cm from its goal (tolerance 0.05 m); matched, see
-  test_localization's figures. The particles are left as they are.
+  wanders in it: on the loop round turtlebot3_world's pillars (2 seeds,
+  shipped map; after the first quarter) the mean was median 3.2, p95 4.9,
+  worst 5.4 cm off the truth, matched 1.6, 3.3, 3.7 cm (2026-11-24,
+  test_localization), and a robot stopping on the mean ended up to 6.5 cm
+  from its goal (tolerance 0.05 m). The particles are left as they are.
 """
 import dataclasses
 import math
