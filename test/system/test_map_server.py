@@ -91,7 +91,8 @@ def test_map_saver_saves_it_back_byte_for_byte(served, repo_root, tmp_path):
                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=TIMEOUT)
     print('MEASURED map_saver output:\n' + saver.stdout)
     assert saver.returncode == 0, saver.stdout
-    for line in ('Waiting for the map', 'Received a 126 X 140 map @ 0.050 m/pix',
+    grid = load_map(str(repo_root / 'maps' / 'turtlebot3_world.yaml')).grid
+    for line in ('Waiting for the map', 'Received a %d X %d map @ 0.050 m/pix' % (grid.width, grid.height),
                  'Writing map occupancy data to turtlebot3_world.pgm', 'Done'):
         assert line in saver.stdout
     for suffix in ('.pgm', '.yaml'):
