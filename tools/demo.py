@@ -133,6 +133,18 @@ def write_calibration(args, calibrated, total):
     say('wrote %s and %s' % (picture, summary_file))
 
 
+def write_walkthrough(args, lines, total, table_name, picture_name, draw, *written):
+    """A mapping or navigation walkthrough's table printed and written to OUTPUT/table_name,
+    its picture drawn (draw(path)) to OUTPUT/picture_name."""
+    text = '\n'.join(lines + ['', 'total wall time %.1f s' % total])
+    print('\n' + text, flush=True)
+    table, picture = os.path.join(args.output, table_name), os.path.join(args.output, picture_name)
+    with open(table, 'w') as summary:
+        summary.write(text + '\n')
+    draw(picture)
+    say('wrote %s' % ', '.join(list(written) + [table, picture]))
+
+
 def main(argv=None):
     args = parse_args(argv)
     log_dir = os.path.join(args.output, 'logs')
@@ -195,29 +207,15 @@ def main(argv=None):
     if calibrated is not None:
         write_calibration(args, calibrated, total)
     if mapped is not None:
-        text = '\n'.join(mapping.table(mapped) + ['', 'total wall time %.1f s' % total])
-        print('\n' + text, flush=True)
-        with open(os.path.join(args.output, 'slam.txt'), 'w') as summary:
-            summary.write(text + '\n')
-        mapping.draw(mapped, os.path.join(args.output, 'slam_map.png'))
-        say('wrote %s, %s and %s' % (mapped.map_yaml, os.path.join(args.output, 'slam.txt'),
-                                     os.path.join(args.output, 'slam_map.png')))
+        write_walkthrough(args, mapping.table(mapped), total, 'slam.txt', 'slam_map.png',
+                          lambda picture: mapping.draw(mapped, picture), mapped.map_yaml)
     if explored is not None and navigated is not None:
-        text = '\n'.join(exploring.table(explored) + [''] + navigating.table(navigated)
-                         + ['', 'total wall time %.1f s' % total])
-        print('\n' + text, flush=True)
-        with open(os.path.join(args.output, 'explore.txt'), 'w') as summary:
-            summary.write(text + '\n')
-        exploring.draw(explored, os.path.join(args.output, 'explore.png'), navigated.truth)
-        say('wrote %s, %s and %s' % (explored.map_yaml, os.path.join(args.output, 'explore.txt'),
-                                     os.path.join(args.output, 'explore.png')))
+        write_walkthrough(args, exploring.table(explored) + [''] + navigating.table(navigated), total, 'explore.txt',
+                          'explore.png', lambda picture: exploring.draw(explored, picture, navigated.truth),
+                          explored.map_yaml)
     elif navigated is not None:
-        text = '\n'.join(navigating.table(navigated) + ['', 'total wall time %.1f s' % total])
-        print('\n' + text, flush=True)
-        with open(os.path.join(args.output, 'nav.txt'), 'w') as summary:
-            summary.write(text + '\n')
-        navigating.draw(navigated, os.path.join(args.output, 'nav_paths.png'))
-        say('wrote %s and %s' % (os.path.join(args.output, 'nav.txt'), os.path.join(args.output, 'nav_paths.png')))
+        write_walkthrough(args, navigating.table(navigated), total, 'nav.txt', 'nav_paths.png',
+                          lambda picture: navigating.draw(navigated, picture))
     model = args.model or os.environ.get('TURTLEBOT3_MODEL', 'burger')
     if results:
         header = ['tb3_sim_nav demo: the tutorial\'s scripts on the pybullet TurtleBot3 %s' % model,
