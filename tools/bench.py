@@ -158,6 +158,7 @@ def measure_frames(runs):
     on Mesa's llvmpipe (the simulator's choice) and, in a world without it,
     with its TinyRenderer (once loaded, the plugin renders every image)."""
     from tb3_sim_nav.camera import Camera
+    from tb3_sim_nav.frames import planar
     from tb3_sim_nav.params import resolve
     from tb3_sim_nav.robot_model import load_model
     from tb3_sim_nav.simulation import Simulation
@@ -171,7 +172,7 @@ def measure_frames(runs):
             if cameras:
                 import pybullet
                 egl = simulation.world.renderer != pybullet.ER_TINY_RENDERER
-            body = simulation.add_robot('', model, (-2.0, -0.5, 0.0, 0.0)).body
+            body = simulation.add_robot('', model, planar(-2.0, -0.5)).body
             for width, height in FRAME_SIZES:
                 camera = Camera(body, model.cameras[0], width, height, model.cameras[0].horizontal_fov, 30.0)
                 camera.render()  # the first frame sets the renderer up
