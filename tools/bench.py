@@ -38,6 +38,9 @@ THREE = ['tb3_0', 'tb3_1', 'tb3_2']
 #: Seven more robots for ten in turtlebot3_world, between the pillars.
 SEVEN = [('tb3_%d' % (3 + index), position) for index, position in enumerate(
     [(0.55, 0.55), (-0.55, 0.55), (0.55, -0.55), (-0.55, -0.55), (1.65, 0.55), (1.65, -0.55), (0.55, 1.65)])]
+#: Twenty-seven more for thirty in turtlebot3_house: free spots of its floor, found by
+#: house_spots() (far from multi_tb3.launch's three and from each other).
+HOUSE_ROBOTS = 27
 # (label, launch file and arguments, its robots' names, sensors switched off, read by a
 # rospy node, target). Each topic of each robot is read by a TcprosReader
 # (nearly free), or by one rospy node, which handles each message in python.
@@ -53,7 +56,9 @@ RTF_ROWS = [('1 robot, empty world, every topic read', EMPTY_WORLD, [''], {}, Fa
             ('3 robots, turtlebot3_house (multi_tb3.launch), every topic read', MULTI_HOUSE, THREE, {}, False,
              None),
             ('10 robots, turtlebot3_world, every topic read', MULTI_WORLD, THREE + [name for name, _ in SEVEN], {},
-             False, None)]
+             False, None),
+            ('30 robots, turtlebot3_house, every topic read', MULTI_HOUSE,
+             THREE + ['tb3_%d' % (3 + index) for index in range(HOUSE_ROBOTS)], {}, False, None)]
 CPU_SCRIPT = 'odom_out_and_back.py'  # the tutorial script that reads tf
 FRAME_SIZES = [(320, 240), (640, 360), (640, 480), (1280, 720), (1920, 1080)]
 # (label, model, camera size and rate or None for the defaults, camera topics
@@ -101,21 +106,42 @@ class Listener(object):
         self.subscribers = []
 
 
+def house_spots(count, clearance=0.5, spacing=1.0):
+    """`count` (x, y) spots of turtlebot3_house's floor, on a grid, at least
+    `clearance` m from any wall and `spacing` m from multi_tb3.launch's three."""
+    import numpy as np
+    from tb3_sim_nav.world_file import load_world
+    from tb3_sim_nav.world_map import in_plane, signed_distance
+    walls = in_plane(load_world('turtlebot3_house', os.path.join(ROOT, 'worlds')).obstacles, 0.1)
+    taken = [(-7.0, -1.0), (-7.0, 1.0), (-5.0, 1.0)]  # multi_tb3.launch's defaults (first, second, third)
+    xs, ys = np.meshgrid(np.arange(-7.5, 7.6, spacing), np.arange(-4.5, 4.6, spacing))
+    grid = np.column_stack((xs.ravel(), ys.ravel()))
+    free = grid[signed_distance(walls, grid) > clearance]
+    free = [tuple(spot) for spot in free if min(math.dist(spot, other) for other in taken) >= spacing]
+    if len(free) < count:
+        raise RunError('turtlebot3_house has %d free spots, not %d' % (len(free), count))
+    return [free[index * len(free) // count] for index in range(count)]
+
+
 def start_sim(name, log_dir, factor, launch=EMPTY_WORLD, sensors=None, robots=('',)):
     """One of the tutorial's launches at `factor`; `sensors` maps 'scan' and
     'imu' to False to switch them off (private parameters of /tb3_sim); more
-    than three `robots`: the seven of SEVEN join MULTI_WORLD's three."""
+    than three `robots`: the seven of SEVEN join MULTI_WORLD's three, or the
+    house's spots join MULTI_HOUSE's three."""
     import rosgraph
     master = rosgraph.Master('/tb3_bench')
     for key in ('scan', 'imu'):
         master.setParam('/tb3_sim/' + key, (sensors or {}).get(key, True))
     argv = LAUNCH + launch.split() + ['real_time_factor:=%g' % factor]
     if len(robots) > len(THREE):
-        world = os.path.join(log_dir, 'ten_robots.yaml')
-        with open(os.path.join(ROOT, 'worlds', 'turtlebot3_world.yaml')) as walls, open(world, 'w') as ten:
-            ten.write(walls.read() + 'robots:\n' + ''.join(
-                '  - {name: %s, model: burger, position: [%g, %g]}\n' % ((name,) + position)
-                for name, position in SEVEN))
+        house = launch == MULTI_HOUSE
+        extra = (zip(robots[len(THREE):], house_spots(len(robots) - len(THREE))) if house else SEVEN)
+        world = os.path.join(log_dir, 'many_robots.yaml')
+        source = os.path.join(ROOT, 'worlds', 'turtlebot3_house.yaml' if house else 'turtlebot3_world.yaml')
+        with open(source) as walls, open(world, 'w') as many:
+            many.write(walls.read() + 'robots:\n' + ''.join(
+                '  - {name: %s, model: burger, position: [%g, %g]}\n' % ((name,) + tuple(position))
+                for name, position in extra))
         argv.append('world:=' + world)  # roslaunch: the last world:= wins
     return Process(name, argv, log_dir)
 

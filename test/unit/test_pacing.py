@@ -30,7 +30,7 @@ def pacer(factor, wall, **kwargs):
 
 
 def run_steps(pace, wall, first, count, compute=COMPUTE):
-    """Steps first..first+count-1 as ros_node's loop does; the sleep (or None) before each."""
+    """Steps first..first+count-1 as the node's step loop does; the sleep (or None) before each."""
     slept = []
     for step in range(first, first + count):
         before = len(wall.sleeps)
