@@ -30,6 +30,18 @@ def load_urdf(p, text, pose=IDENTITY, **options):
         return p.loadURDF(path, pose[0], pose[1], **options)
 
 
+def link_frame(p, body, link):
+    """(position, orientation) in the world of link index `link`'s URDF frame, as
+    the body stands now. Without computeForwardKinematics pybullet answers with
+    the poses its last step computed before it moved the base: one physics step
+    old, which put a turning robot's scan 0.57 degrees per rad/s behind its base
+    at 100 Hz (1.6 degrees at the Burger's 2.84 rad/s). Recomputing costs 0.4 us
+    a call (3.3 instead of 2.9 us, medians of 7 x 20000 calls, 2026-11-23): for a
+    lidar read at 5 Hz with physics at 100 Hz, 0.02 us a step."""
+    state = p.getLinkState(body, link, computeForwardKinematics=1)
+    return state[4], state[5]
+
+
 class Body(object):
     """What every body shares: its world, name, pybullet id, links and joints,
     poses and velocities, a bounding radius (for the rays), teleport and removal.
@@ -72,11 +84,10 @@ class Body(object):
         return self.p.getBaseVelocity(self.id)
 
     def link_pose(self, link):
-        """A link's frame in the world (the model frame, for the base)."""
+        """A link's frame in the world (the model frame, for the base), where it is now."""
         if link == self.base_link:
             return self.base_pose()
-        state = self.p.getLinkState(self.id, self.links[link])
-        return state[4], state[5]
+        return link_frame(self.p, self.id, self.links[link])
 
     def teleport(self, pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0)):
         """The model frame to `pose`, moving at `linear` and `angular` (world axes)."""

@@ -23,7 +23,7 @@ import numpy as np
 import pybullet
 from pybullet_utils.bullet_client import BulletClient
 
-from .bodies import ObjectBody, RobotBody, int32, load_urdf
+from .bodies import ObjectBody, RobotBody, int32, link_frame, load_urdf
 from .frames import IDENTITY, compose, inverse, planar, yaw_of
 from .model_files import Shape
 from .rays import StaticScene
@@ -185,8 +185,7 @@ class World(object):
                 if kind is None:
                     continue
                 if link not in frames:
-                    state = p.getLinkState(body.id, link)
-                    frames[link] = (state[4], state[5])
+                    frames[link] = link_frame(p, body.id, link)
                 size = {'box': tuple(dimensions[:3]), 'cylinder': (dimensions[1], dimensions[0]),
                         'sphere': (dimensions[0],)}[kind]
                 shapes.append((name, Shape(kind, size, compose(frames[link], (data[5], data[6])), tuple(data[7]))))
