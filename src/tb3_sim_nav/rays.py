@@ -9,9 +9,12 @@ every lidar due in a step are tested at once, each against the shapes
 within its reach, in closed form: a slab test in the shape's own frame for
 a box, a circle and two caps for a cylinder, a quadratic for a sphere.
 
-What pybullet does and this keeps (measured against rayTestBatch, see
-test_rays.py): a ray that starts inside a shape does not hit that shape;
-the ground (the plane z = 0) is hit from above and from below.
+What pybullet does and this keeps (measured against rayTestBatch in
+test_sensors.py): a ray that starts inside a shape does not hit that shape;
+the ground (the plane z = 0) is hit from above and from below. What it does
+not keep: Bullet's convex cast stops up to 6 mm short of a cylinder; here
+every shape is met at its exact surface (test_rays.py works the distances
+out by hand).
 """
 import numpy as np
 
