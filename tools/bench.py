@@ -217,8 +217,9 @@ def measure_frames(runs):
 
 def measure_camera(log_dir, model, size, rate, topics, seconds):
     """At factor 1 in turtlebot3_world, with the camera's `topics` read (None:
-    rviz shows camera.rviz on an Xvfb screen): sim seconds per wall second and
-    the simulator's CPU (% of a core)."""
+    rviz shows camera.rviz on an Xvfb screen): sim seconds per wall second, the
+    simulator's CPU (% of a core) and the colour images a sim second (a camera
+    drops frames rather than hold the world back: ros/sensor_io.py)."""
     import rosgraph
     master = rosgraph.Master('/tb3_bench')
     for key, value in zip(('camera_width', 'camera_height', 'camera_rate'), (size or (None, None)) + (rate,)):
@@ -232,8 +233,11 @@ def measure_camera(log_dir, model, size, rate, topics, seconds):
     sim = Process('camera_' + model, LAUNCH + [WALLED_WORLD, 'model:=' + model], log_dir)
     readers, viewers = [], []
     try:
-        readers = [TcprosReader(sim_uri, topic) for topic in ['/clock'] + ['/camera/' + topic for topic in topics or []]]
-        clock = readers[0]
+        frames = []  # one None a colour image (counted, not kept; beside rviz, by one more reader)
+        readers = [TcprosReader(sim_uri, '/camera/rgb/image_raw', keep=lambda body: frames.append(None))] + [
+            TcprosReader(sim_uri, topic) for topic in ['/clock'] + ['/camera/' + topic for topic in topics or []
+                                                                     if topic != 'rgb/image_raw']]
+        clock = readers[1]
         wait_until(lambda: clock.clock is not None and clock.clock > 2.0, 120, '/clock')
         if topics is None:
             xvfb, display = start_xvfb()
@@ -241,10 +245,11 @@ def measure_camera(log_dir, model, size, rate, topics, seconds):
                                      log_dir, env=dict(os.environ, DISPLAY=display))]
             time.sleep(RVIZ_SETTLE)
         pid = sim_pid()
-        sim_start, wall_start, cpu_start = clock.clock, time.monotonic(), cpu_seconds(pid)
+        sim_start, wall_start, cpu_start, frames_start = clock.clock, time.monotonic(), cpu_seconds(pid), len(frames)
         time.sleep(seconds)
-        sim_end, wall_end, cpu_end = clock.clock, time.monotonic(), cpu_seconds(pid)
-        return (sim_end - sim_start) / (wall_end - wall_start), 100.0 * (cpu_end - cpu_start) / (wall_end - wall_start)
+        sim_end, wall_end, cpu_end, frames_end = clock.clock, time.monotonic(), cpu_seconds(pid), len(frames)
+        return ((sim_end - sim_start) / (wall_end - wall_start), 100.0 * (cpu_end - cpu_start) / (wall_end - wall_start),
+                (frames_end - frames_start) / (sim_end - sim_start))
     finally:
         for process in reversed(viewers):
             process.stop()
@@ -395,8 +400,9 @@ def main(argv=None):
             for label, model, size, rate, topics in CAMERA_ROWS:
                 cameras[label] = [measure_camera(log_dir, model, size, rate, topics, args.cpu_seconds)
                                   for _ in range(args.runs)]
-                say('camera %s: real-time factor %s, CPU %s' % (label, [round(r, 2) for r, _ in cameras[label]],
-                                                                [round(c, 1) for _, c in cameras[label]]))
+                say('camera %s: real-time factor %s, CPU %s, frames a sim second %s' % (
+                    label, [round(r, 2) for r, _, _ in cameras[label]], [round(c, 1) for _, c, _ in cameras[label]],
+                    [round(f, 1) for _, _, f in cameras[label]]))
         scripts = {}
         if 'scripts' in parts:
             for factor in (1.0, 0.0):
@@ -432,11 +438,13 @@ def main(argv=None):
                 lines.append('%-58s %6.1f / %5.1f ms;  %6.1f / %5.1f ms' % (
                     ('  %d x %d' % (width, height),) + frames[('egl', width, height)] + frames[('tiny', width, height)]))
         if cameras:
-            lines.append('factor 1 in turtlebot3_world, the camera read: real-time factor, CPU of the simulator:')
+            lines.append('factor 1 in turtlebot3_world, the camera read: real-time factor, CPU of the simulator, '
+                         'colour images a sim second:')
             for label, _, _, _, _ in CAMERA_ROWS:
-                factor = median([r for r, _ in cameras[label]])
-                lines.append('%-58s %7.2f  %5.1f%%  %s' % ('  ' + label, factor, median([c for _, c in cameras[label]]),
-                                                           'real time: %s' % verdict(factor >= 0.95)))
+                factor = median([r for r, _, _ in cameras[label]])
+                lines.append('%-58s %7.2f  %5.1f%%  %5.1f Hz  %s' % (
+                    '  ' + label, factor, median([c for _, c, _ in cameras[label]]),
+                    median([f for _, _, f in cameras[label]]), 'real time: %s' % verdict(factor >= 0.95)))
         if rss:
             lines.append('%-58s %8.0f MiB' % ('peak RSS of the simulator node (max over runs)', max(rss)))
         for script, _ in (tutorial.SCRIPTS if scripts else []):

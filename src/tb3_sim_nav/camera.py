@@ -6,6 +6,7 @@ frame's terms (x right, y down, z forward). Square pixels, no distortion,
 the principal point at the image's centre.
 """
 import math
+import time
 
 import numpy as np
 
@@ -50,6 +51,7 @@ class Camera(Sensor):
         self.fx = self.fy = width / (2.0 * math.tan(horizontal_fov / 2.0))
         self.cx, self.cy = (width - 1) / 2.0, (height - 1) / 2.0  # pixel centres at integer coordinates
         vertical_fov = 2.0 * math.atan(height / (2.0 * self.fy))
+        self.render_seconds = 0.0  # wall time the last render() took
         self._projection = body.p.computeProjectionMatrixFOV(math.degrees(vertical_fov), width / float(height),
                                                               spec.near, spec.far)
 
@@ -67,6 +69,7 @@ class Camera(Sensor):
         """(rgb, depth): H x W x 3 uint8 and H x W float32 metres along the
         optical axis, NaN where nothing is within the far clip or a depth
         camera's cutoff."""
+        started = time.perf_counter()
         position, orientation = self.body.link_pose(self.spec.link)
         axes = matrix(orientation)
         view = self.body.p.computeViewMatrix(position, np.add(position, axes[:, 0]), axes[:, 2])
@@ -75,7 +78,9 @@ class Camera(Sensor):
         buffer = np.asarray(buffer, dtype=np.float32)
         depth = (near * far / (far - (far - near) * buffer)).astype(np.float32)
         depth[(buffer >= 1.0) | (depth < self.spec.cutoff)] = np.nan
-        return np.ascontiguousarray(rgba[:, :, :3]), depth
+        rgb = np.ascontiguousarray(rgba[:, :, :3])
+        self.render_seconds = time.perf_counter() - started
+        return rgb, depth
 
     def points(self, depth):
         """The organised cloud of a depth image: H x W x 3 float32 (x right, y

@@ -74,10 +74,11 @@ class Fleet(object):
         for io in self.robots.values():
             io.apply_command(now_ns)
 
-    def publish(self, now_ns, stamp):
-        """Publishes what is due at `now_ns`: every due sensor read at once. Returns
-        the IOs that published and the transforms they give the step's tf message."""
-        due = [sensor for io in self.robots.values() for sensor in io.sensors if sensor.due(now_ns)]
+    def publish(self, now_ns, stamp, paced=False):
+        """Publishes what is due at `now_ns` (`paced`: at a real-time factor), every due
+        sensor read at once. Returns the IOs that published and the transforms they
+        give the step's tf message."""
+        due = [sensor for io in self.robots.values() for sensor in io.sensors if sensor.due(now_ns, paced)]
         reading = [sensor for sensor in due if sensor.needs_reading()]
         readings = dict(zip(map(id, reading), read_all([io.sensor for io in reading], now_ns)))
         transforms = []

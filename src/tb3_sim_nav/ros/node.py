@@ -150,7 +150,7 @@ class SimulatorNode(object):
 
     def publish_data(self, now_ns, stamp):
         """Publishes what is due at `now_ns`; False if nothing was."""
-        due, transforms = self.fleet.publish(now_ns, stamp)
+        due, transforms = self.fleet.publish(now_ns, stamp, paced=self.pacer.factor > 0.0)
         if transforms:
             if self._own_clock:  # the stamps of our log messages need be no finer
                 rospy_internals.set_time(stamp)

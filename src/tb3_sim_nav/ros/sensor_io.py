@@ -1,7 +1,7 @@
 """Each sensor's ROS side: one IO class per kind of sensor, owning its publishers and its schedule.
 
-An IO is `due(now_ns)` when its schedule says so and someone reads one of its
-topics (the sensors cost most of a step: nobody listening, nothing computed);
+An IO is `due(now_ns, paced)` when its schedule says so and someone reads one of
+its topics (the sensors cost most of a step: nobody listening, nothing computed);
 the node then reads every due sensor at once (sensors.read_all) and hands
 each IO its reading to `publish(stamp, reading)`. An IO whose topics do not
 all need the reading (a camera_info alone) says so in needs_reading().
@@ -11,14 +11,19 @@ A robot with a name lives in its namespace and prefixes its frames, as
 ROBOTIS' multi-robot set-up does (tb3_0/odom, tb3_0/odom -> tb3_0/base_footprint);
 the tutorial's robot has no name.
 """
+import time
+
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan, PointCloud2
 
 from .. import sensors
 from ..camera import Camera
 from ..frames import compose, inverse
-from ..pacing import Schedule
+from ..pacing import Schedule, WallShare
 from . import messages
+
+#: The most of the wall time a camera's frames may take while paced (CameraIO).
+CAMERA_WALL_SHARE = 0.5
 
 
 class SensorIO(object):
@@ -40,7 +45,8 @@ class SensorIO(object):
     def wanted(self):
         return any(publisher.get_num_connections() for publisher in self.publishers)
 
-    def due(self, now_ns):
+    def due(self, now_ns, paced=False):
+        """`paced`: the simulation keeps to a real-time factor (not as fast as possible)."""
         return self.schedule.due(now_ns) and self.wanted()
 
     def needs_reading(self):
@@ -134,10 +140,22 @@ class ImuIO(SensorIO):
 class CameraIO(SensorIO):
     """One camera's topics, as Gazebo's camera plugins name them: the colour
     image and its camera_info; a depth camera's depth image, its camera_info
-    and its cloud too. Rendered only while someone subscribes to an image."""
+    and its cloud too. Rendered only while someone subscribes to an image.
+
+    Paced, a camera's frames (render and publish) take at most
+    CAMERA_WALL_SHARE of the wall time, and a frame due before then is
+    dropped, as Gazebo's rendering, which runs beside its physics, delivers
+    fewer frames when short of time and never slows the world down. A frame
+    costs 40 ms of CPU on Mesa's llvmpipe at best; on this 2-core VM, shared
+    and loaded, 85 ms and 0.5 s of wall time: rendering every frame held the
+    world at 0.1 of real time (rviz_camera.test's robot did not get round its
+    circle). On a quiet machine a 640 x 480 frame takes 32 ms of wall time:
+    the default 15 Hz (67 ms apart) all render. As fast as possible (factor
+    0), every frame is rendered."""
 
     def __init__(self, sensor, prefix, publishers, config):
         super(CameraIO, self).__init__(sensor, prefix)
+        self._share = WallShare(CAMERA_WALL_SHARE)
         spec = sensor.spec
         frame = prefix + spec.frame
         self.image = messages.image(frame, sensor.width, sensor.height, 'rgb8')
@@ -156,7 +174,12 @@ class CameraIO(SensorIO):
         return any(publisher is not None and publisher.get_num_connections()
                    for publisher in (self.image_pub, self.depth_pub, self.points_pub))
 
+    def due(self, now_ns, paced=False):
+        return super(CameraIO, self).due(now_ns) and not (paced and not self._share.allows() and
+                                                          self.needs_reading())
+
     def publish(self, stamp, reading):
+        started = time.monotonic()
         if reading is not None:
             rgb, depth = reading
             if self.image_pub.get_num_connections():
@@ -172,6 +195,8 @@ class CameraIO(SensorIO):
         for publisher in self.info_pubs:
             if publisher.get_num_connections():
                 publisher.publish(self.info)
+        if reading is not None:
+            self._share.spent(self.sensor.render_seconds + time.monotonic() - started)
 
 
 #: The IO class of each kind of sensor.
