@@ -38,6 +38,9 @@ THREE = ['tb3_0', 'tb3_1', 'tb3_2']
 #: Seven more robots for ten in turtlebot3_world, between the pillars.
 SEVEN = [('tb3_%d' % (3 + index), position) for index, position in enumerate(
     [(0.55, 0.55), (-0.55, 0.55), (0.55, -0.55), (-0.55, -0.55), (1.65, 0.55), (1.65, -0.55), (0.55, 1.65)])]
+#: Twenty-seven more for thirty in turtlebot3_house: free spots of its floor, found by
+#: house_spots() (far from multi_tb3.launch's three and from each other).
+HOUSE_ROBOTS = 27
 # (label, launch file and arguments, its robots' names, sensors switched off, read by a
 # rospy node, target). Each topic of each robot is read by a TcprosReader
 # (nearly free), or by one rospy node, which handles each message in python.
@@ -53,7 +56,9 @@ RTF_ROWS = [('1 robot, empty world, every topic read', EMPTY_WORLD, [''], {}, Fa
             ('3 robots, turtlebot3_house (multi_tb3.launch), every topic read', MULTI_HOUSE, THREE, {}, False,
              None),
             ('10 robots, turtlebot3_world, every topic read', MULTI_WORLD, THREE + [name for name, _ in SEVEN], {},
-             False, None)]
+             False, None),
+            ('30 robots, turtlebot3_house, every topic read', MULTI_HOUSE,
+             THREE + ['tb3_%d' % (3 + index) for index in range(HOUSE_ROBOTS)], {}, False, None)]
 CPU_SCRIPT = 'odom_out_and_back.py'  # the tutorial script that reads tf
 FRAME_SIZES = [(320, 240), (640, 360), (640, 480), (1280, 720), (1920, 1080)]
 # (label, model, camera size and rate or None for the defaults, camera topics
@@ -101,21 +106,42 @@ class Listener(object):
         self.subscribers = []
 
 
+def house_spots(count, clearance=0.5, spacing=1.0):
+    """`count` (x, y) spots of turtlebot3_house's floor, on a grid, at least
+    `clearance` m from any wall and `spacing` m from multi_tb3.launch's three."""
+    import numpy as np
+    from tb3_sim_nav.world_file import load_world
+    from tb3_sim_nav.world_map import in_plane, signed_distance
+    walls = in_plane(load_world('turtlebot3_house', os.path.join(ROOT, 'worlds')).obstacles, 0.1)
+    taken = [(-7.0, -1.0), (-7.0, 1.0), (-5.0, 1.0)]  # multi_tb3.launch's defaults (first, second, third)
+    xs, ys = np.meshgrid(np.arange(-7.5, 7.6, spacing), np.arange(-4.5, 4.6, spacing))
+    grid = np.column_stack((xs.ravel(), ys.ravel()))
+    free = grid[signed_distance(walls, grid) > clearance]
+    free = [tuple(spot) for spot in free if min(math.dist(spot, other) for other in taken) >= spacing]
+    if len(free) < count:
+        raise RunError('turtlebot3_house has %d free spots, not %d' % (len(free), count))
+    return [free[index * len(free) // count] for index in range(count)]
+
+
 def start_sim(name, log_dir, factor, launch=EMPTY_WORLD, sensors=None, robots=('',)):
     """One of the tutorial's launches at `factor`; `sensors` maps 'scan' and
     'imu' to False to switch them off (private parameters of /tb3_sim); more
-    than three `robots`: the seven of SEVEN join MULTI_WORLD's three."""
+    than three `robots`: the seven of SEVEN join MULTI_WORLD's three, or the
+    house's spots join MULTI_HOUSE's three."""
     import rosgraph
     master = rosgraph.Master('/tb3_bench')
     for key in ('scan', 'imu'):
         master.setParam('/tb3_sim/' + key, (sensors or {}).get(key, True))
     argv = LAUNCH + launch.split() + ['real_time_factor:=%g' % factor]
     if len(robots) > len(THREE):
-        world = os.path.join(log_dir, 'ten_robots.yaml')
-        with open(os.path.join(ROOT, 'worlds', 'turtlebot3_world.yaml')) as walls, open(world, 'w') as ten:
-            ten.write(walls.read() + 'robots:\n' + ''.join(
-                '  - {name: %s, model: burger, position: [%g, %g]}\n' % ((name,) + position)
-                for name, position in SEVEN))
+        house = launch == MULTI_HOUSE
+        extra = (zip(robots[len(THREE):], house_spots(len(robots) - len(THREE))) if house else SEVEN)
+        world = os.path.join(log_dir, 'many_robots.yaml')
+        source = os.path.join(ROOT, 'worlds', 'turtlebot3_house.yaml' if house else 'turtlebot3_world.yaml')
+        with open(source) as walls, open(world, 'w') as many:
+            many.write(walls.read() + 'robots:\n' + ''.join(
+                '  - {name: %s, model: burger, position: [%g, %g]}\n' % ((name,) + tuple(position))
+                for name, position in extra))
         argv.append('world:=' + world)  # roslaunch: the last world:= wins
     return Process(name, argv, log_dir)
 
@@ -158,6 +184,7 @@ def measure_frames(runs):
     on Mesa's llvmpipe (the simulator's choice) and, in a world without it,
     with its TinyRenderer (once loaded, the plugin renders every image)."""
     from tb3_sim_nav.camera import Camera
+    from tb3_sim_nav.frames import planar
     from tb3_sim_nav.params import resolve
     from tb3_sim_nav.robot_model import load_model
     from tb3_sim_nav.simulation import Simulation
@@ -171,7 +198,7 @@ def measure_frames(runs):
             if cameras:
                 import pybullet
                 egl = simulation.world.renderer != pybullet.ER_TINY_RENDERER
-            body = simulation.add_robot('', model, (-2.0, -0.5, 0.0, 0.0)).body
+            body = simulation.add_robot('', model, planar(-2.0, -0.5)).body
             for width, height in FRAME_SIZES:
                 camera = Camera(body, model.cameras[0], width, height, model.cameras[0].horizontal_fov, 30.0)
                 camera.render()  # the first frame sets the renderer up
@@ -190,8 +217,9 @@ def measure_frames(runs):
 
 def measure_camera(log_dir, model, size, rate, topics, seconds):
     """At factor 1 in turtlebot3_world, with the camera's `topics` read (None:
-    rviz shows camera.rviz on an Xvfb screen): sim seconds per wall second and
-    the simulator's CPU (% of a core)."""
+    rviz shows camera.rviz on an Xvfb screen): sim seconds per wall second, the
+    simulator's CPU (% of a core) and the colour images a sim second (a camera
+    drops frames rather than hold the world back: ros/sensor_io.py)."""
     import rosgraph
     master = rosgraph.Master('/tb3_bench')
     for key, value in zip(('camera_width', 'camera_height', 'camera_rate'), (size or (None, None)) + (rate,)):
@@ -205,8 +233,11 @@ def measure_camera(log_dir, model, size, rate, topics, seconds):
     sim = Process('camera_' + model, LAUNCH + [WALLED_WORLD, 'model:=' + model], log_dir)
     readers, viewers = [], []
     try:
-        readers = [TcprosReader(sim_uri, topic) for topic in ['/clock'] + ['/camera/' + topic for topic in topics or []]]
-        clock = readers[0]
+        frames = []  # one None a colour image (counted, not kept; beside rviz, by one more reader)
+        readers = [TcprosReader(sim_uri, '/camera/rgb/image_raw', keep=lambda body: frames.append(None))] + [
+            TcprosReader(sim_uri, topic) for topic in ['/clock'] + ['/camera/' + topic for topic in topics or []
+                                                                     if topic != 'rgb/image_raw']]
+        clock = readers[1]
         wait_until(lambda: clock.clock is not None and clock.clock > 2.0, 120, '/clock')
         if topics is None:
             xvfb, display = start_xvfb()
@@ -214,10 +245,11 @@ def measure_camera(log_dir, model, size, rate, topics, seconds):
                                      log_dir, env=dict(os.environ, DISPLAY=display))]
             time.sleep(RVIZ_SETTLE)
         pid = sim_pid()
-        sim_start, wall_start, cpu_start = clock.clock, time.monotonic(), cpu_seconds(pid)
+        sim_start, wall_start, cpu_start, frames_start = clock.clock, time.monotonic(), cpu_seconds(pid), len(frames)
         time.sleep(seconds)
-        sim_end, wall_end, cpu_end = clock.clock, time.monotonic(), cpu_seconds(pid)
-        return (sim_end - sim_start) / (wall_end - wall_start), 100.0 * (cpu_end - cpu_start) / (wall_end - wall_start)
+        sim_end, wall_end, cpu_end, frames_end = clock.clock, time.monotonic(), cpu_seconds(pid), len(frames)
+        return ((sim_end - sim_start) / (wall_end - wall_start), 100.0 * (cpu_end - cpu_start) / (wall_end - wall_start),
+                (frames_end - frames_start) / (sim_end - sim_start))
     finally:
         for process in reversed(viewers):
             process.stop()
@@ -394,8 +426,9 @@ def main(argv=None):
             for label, model, size, rate, topics in CAMERA_ROWS:
                 cameras[label] = [measure_camera(log_dir, model, size, rate, topics, args.cpu_seconds)
                                   for _ in range(args.runs)]
-                say('camera %s: real-time factor %s, CPU %s' % (label, [round(r, 2) for r, _ in cameras[label]],
-                                                                [round(c, 1) for _, c in cameras[label]]))
+                say('camera %s: real-time factor %s, CPU %s, frames a sim second %s' % (
+                    label, [round(r, 2) for r, _, _ in cameras[label]], [round(c, 1) for _, c, _ in cameras[label]],
+                    [round(f, 1) for _, _, f in cameras[label]]))
         scripts = {}
         if 'scripts' in parts:
             for factor in (1.0, 0.0):
@@ -442,11 +475,13 @@ def main(argv=None):
                 lines.append('%-58s %6.1f / %5.1f ms;  %6.1f / %5.1f ms' % (
                     ('  %d x %d' % (width, height),) + frames[('egl', width, height)] + frames[('tiny', width, height)]))
         if cameras:
-            lines.append('factor 1 in turtlebot3_world, the camera read: real-time factor, CPU of the simulator:')
+            lines.append('factor 1 in turtlebot3_world, the camera read: real-time factor, CPU of the simulator, '
+                         'colour images a sim second:')
             for label, _, _, _, _ in CAMERA_ROWS:
-                factor = median([r for r, _ in cameras[label]])
-                lines.append('%-58s %7.2f  %5.1f%%  %s' % ('  ' + label, factor, median([c for _, c in cameras[label]]),
-                                                           'real time: %s' % verdict(factor >= 0.95)))
+                factor = median([r for r, _, _ in cameras[label]])
+                lines.append('%-58s %7.2f  %5.1f%%  %5.1f Hz  %s' % (
+                    '  ' + label, factor, median([c for _, c, _ in cameras[label]]),
+                    median([f for _, _, f in cameras[label]]), 'real time: %s' % verdict(factor >= 0.95)))
         if rss:
             lines.append('%-58s %8.0f MiB' % ('peak RSS of the simulator node (max over runs)', max(rss)))
         for script, _ in (tutorial.SCRIPTS if scripts else []):

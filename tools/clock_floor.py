@@ -15,7 +15,8 @@ from rosgraph_msgs.msg import Clock
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, '..', 'src'))
 
-from tb3_sim_nav.pacing import Pacer  # noqa: E402 (after the path)
+from tb3_sim_nav.frames import IDENTITY  # noqa: E402 (after the path)
+from tb3_sim_nav.pacing import Pacer  # noqa: E402
 from tb3_sim_nav.ros.publishers import Publishers  # noqa: E402
 from tb3_sim_nav.ros.rospy_internals import stop_following_clock  # noqa: E402
 from tb3_sim_nav.throttle import Throttle  # noqa: E402
@@ -33,7 +34,7 @@ def main():
     world = World(time_step=1.0 / PHYSICS_RATE) if args.physics else None
     if world:
         with open(os.path.join(HERE, '..', 'urdf', 'turtlebot3_burger.urdf')) as urdf:
-            world.add_robot(urdf.read(), (0.0, 0.0, 0.0, 0.0))
+            world.add_robot(urdf.read(), IDENTITY)
     clock = Publishers(Throttle(10.0)).advertise('clock', Clock)
     pacer = Pacer(1.0)
     steps = 0

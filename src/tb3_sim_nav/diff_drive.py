@@ -52,20 +52,10 @@ def body_twist(left, right, wheel_radius, wheel_separation):
             wheel_radius * (right - left) / wheel_separation)
 
 
-def yaw_to_quaternion(yaw):
-    """(x, y, z, w) of a rotation by `yaw` about z."""
-    return 0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0)
-
-
 def wrap_angle(angle):
     """`angle` (rad) in (-pi, pi]."""
     wrapped = math.atan2(math.sin(angle), math.cos(angle))
     return math.pi if wrapped == -math.pi else wrapped
-
-
-def quaternion_to_yaw(x, y, z, w):
-    """Rotation about z of a quaternion (x, y, z, w), in (-pi, pi]."""
-    return wrap_angle(math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z)))
 
 
 class EncoderOdometry(object):

@@ -1,7 +1,34 @@
-"""Poses as (position (x, y, z), orientation (x, y, z, w)): compose, invert, express in another frame. No ROS here."""
+"""Poses as (position (x, y, z), orientation (x, y, z, w)): compose, invert, express in another frame. No ROS here.
+
+This is the simulator core's one pose convention: bodies, robots, spawns and
+readings all speak it. A pose given as x, y, z and a heading (launch
+arguments, world files) becomes one through `planar`. Yaw <-> quaternion is
+written once for the whole project, in tb3_navigation.pose2d.
+"""
 import math
 
+import numpy as np
+from tb3_navigation.pose2d import quaternion_of_yaw, yaw_of_quaternion
+
 IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+
+
+def planar(x, y, z=0.0, yaw=0.0):
+    """The pose at (x, y, z) heading `yaw` (rad, about z)."""
+    return (float(x), float(y), float(z)), quaternion_of_yaw(yaw)
+
+
+def yaw_of(orientation):
+    """The heading (rad, about z) of an orientation (x, y, z, w)."""
+    return yaw_of_quaternion(*orientation)
+
+
+def matrix(q):
+    """The 3 x 3 rotation matrix of a unit quaternion (x, y, z, w): its columns are the frame's axes."""
+    x, y, z, w = q
+    return np.array([[1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)],
+                     [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
+                     [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)]])
 
 
 def quaternion_multiply(a, b):

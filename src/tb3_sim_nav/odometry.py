@@ -2,14 +2,14 @@
 
 Both answer `read(truth)` with (pose, twist) given the true ones, so the
 truth is read off the world once per publication; `update()` runs after
-every physics step, `reset(x, y, yaw)` after a reset, and `configure(config)`
-when the knobs change.
+every physics step, `reset(pose)` after a reset (the spawn pose: odometry
+starts there), and `configure(config)` when the knobs change. sensors.Odometry
+is the sensor that holds one.
 """
-import math
-
 import numpy as np
 
 from .diff_drive import EncoderOdometry
+from .frames import planar, yaw_of
 
 
 class WorldOdometry(object):
@@ -21,7 +21,7 @@ class WorldOdometry(object):
     def update(self):
         pass
 
-    def reset(self, x, y, yaw):
+    def reset(self, pose):
         pass
 
     def read(self, truth):
@@ -55,13 +55,12 @@ class WheelOdometry(object):
             angles = np.asarray(angles) + self.rng.normal(0.0, self.noise, 2)
         self.encoders.update(*angles)
 
-    def reset(self, x, y, yaw):
-        self.encoders.reset(x, y, yaw)
+    def reset(self, pose):
+        (x, y, _), orientation = pose
+        self.encoders.reset(x, y, yaw_of(orientation))
 
     def read(self, truth=None):
         encoders = self.encoders
         _, speeds = self.body.wheel_states()
         v, w = encoders.twist(*speeds)
-        pose = ((encoders.x, encoders.y, 0.0),
-                (0.0, 0.0, math.sin(encoders.yaw / 2.0), math.cos(encoders.yaw / 2.0)))
-        return pose, ((v, 0.0, 0.0), (0.0, 0.0, w))
+        return planar(encoders.x, encoders.y, 0.0, encoders.yaw), ((v, 0.0, 0.0), (0.0, 0.0, w))

@@ -73,3 +73,24 @@ class Schedule(object):
         if self.next_ns <= now_ns:  # time jumped ahead: restart the grid from now
             self.next_ns = now_ns + self.period_ns
         return True
+
+
+class WallShare(object):
+    """Lets work that may be skipped (a camera frame) take at most `share` of the wall time.
+
+    After work that took `seconds`, the next may start only once the wall
+    clock has run on by seconds * (1 - share) / share: at 0.5, as long again.
+    """
+
+    def __init__(self, share, wall_clock=time.monotonic):
+        if not 0.0 < share <= 1.0:
+            raise ValueError('a share of wall time must be in (0, 1], not %r' % (share,))
+        self.share = share
+        self._wall_clock = wall_clock
+        self._ready_at = -float('inf')
+
+    def allows(self):
+        return self._wall_clock() >= self._ready_at
+
+    def spent(self, seconds):
+        self._ready_at = self._wall_clock() + seconds * (1.0 - self.share) / self.share

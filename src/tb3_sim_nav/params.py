@@ -13,6 +13,7 @@ import math
 from collections import namedtuple
 from typing import Optional
 
+from .robot import KINDS
 from .robot_model import model_problem
 from .world_file import WorldError, parse_robots
 
@@ -227,7 +228,7 @@ def resolve(lookup, parameters=PARAMETERS):
         if parameter.origin == FROM_PROFILE:
             default = PROFILES[resolved['profile']][parameter.name]
         resolved[parameter.name] = check(parameter, lookup(parameter.name, default))
-    for rate in ('odom_rate', 'joint_states_rate', 'scan_rate', 'imu_rate', 'camera_rate'):
+    for rate in [kind.rate_parameter for kind in KINDS]:  # every sensor's rate
         if resolved[rate] is not None and resolved[rate] > resolved['physics_rate']:
             raise ParameterError('parameter ~%s = %r: must not exceed ~physics_rate = %r'
                                  % (rate, resolved[rate], resolved['physics_rate']))

@@ -1,8 +1,8 @@
 """Has a process finished reacting? Read off Linux's /proc, without ROS.
 
 Faster than real time, the simulator holds each step until the nodes that
-drive the robot have done what the last tick asked of them (see ros_node's
-lockstep). A process has done so when every thread of it sleeps and none ran
+drive the robot have done what the last tick asked of them (see
+ros/lockstep.py). A process has done so when every thread of it sleeps and none ran
 between two looks: Linux marks a thread runnable the moment data, a lock or a
 signal wakes it, so a process whose threads all sleep, none having run
 since a look a moment before, waits for something new from outside.

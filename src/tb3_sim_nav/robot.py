@@ -1,21 +1,22 @@
-"""One simulated robot: its model, body, drive, odometry source and sensors. No ROS here.
+"""One simulated robot: its model, body, drive and sensors. No ROS here.
 
 The simulation steps it (`before_step`, the world's step, `after_step`); the
-ROS edge commands it and reads it off.
+ROS edge commands it and reads its sensors.
 """
-from .camera import DEFAULT_MAX_RATE, Camera, camera_size
+from .camera import Camera
 from .diff_drive import Limits
 from .drive import Drive
-from .odometry import WheelOdometry, WorldOdometry
-from .sensors import Imu, Lidar
+from .sensors import Imu, Lidar, Odometry, WheelEncoders
 
-LIDAR_LINK = 'base_scan'
+#: Every kind of sensor, in the order a robot holds them: each kind's build()
+#: gives a robot its sensors of that kind (none if the config switches it off).
+KINDS = (Odometry, WheelEncoders, Lidar, Imu, Camera)
 
 
 class Robot(object):
 
     def __init__(self, name, model, body, config, spawn_pose, rng):
-        """`spawn_pose` is (x, y, z, yaw); `config` a params.Config."""
+        """`spawn_pose` is (position, orientation); `config` a params.Config."""
         self.name = name
         self.model = model
         self.body = body
@@ -23,17 +24,7 @@ class Robot(object):
         self.limits = Limits(config.max_linear_speed or model.limits.max_linear,
                              config.max_angular_speed or model.limits.max_angular)
         self.drive = Drive(model.geometry)
-        if config.odom_source == 'world':
-            self.odometry_source = WorldOdometry()
-        else:
-            self.odometry_source = WheelOdometry(body, model.geometry, config, rng)
-        self.lidar = Lidar(body, LIDAR_LINK, config.scan_samples, config.scan_range_min, config.scan_range_max,
-                           config.scan_noise, rng) if config.scan else None
-        self.imu = Imu(body, config.imu_gyro_noise, config.imu_accel_noise, rng) if config.imu else None
-        self.cameras = [Camera(body, spec, *camera_size(spec, config.camera_width, config.camera_height),
-                               horizontal_fov=config.camera_horizontal_fov or spec.horizontal_fov,
-                               rate=config.camera_rate or min(spec.rate, DEFAULT_MAX_RATE))
-                        for spec in model.cameras]
+        self.sensors = [sensor for kind in KINDS for sensor in kind.build(body, model, config, rng)]
         self.configure(config)
         self.reset()
 
@@ -41,12 +32,17 @@ class Robot(object):
         """The realism knobs of a params.Config, at start-up or while running."""
         self.drive.configure(config.wheel_acceleration, config.cmd_vel_timeout,
                              (config.left_motor_error, config.right_motor_error))
-        self.odometry_source.configure(config)
         self.body.set_friction(config.ground_friction, config.caster_friction)
-        if self.lidar:
-            self.lidar.noise_stddev = config.scan_noise
-        if self.imu:
-            self.imu.gyro_noise, self.imu.accel_noise = config.imu_gyro_noise, config.imu_accel_noise
+        for sensor in self.sensors:
+            sensor.configure(config)
+
+    def sensor(self, name):
+        """The first sensor named `name`, or None."""
+        return next((sensor for sensor in self.sensors if sensor.name == name), None)
+
+    lidar = property(lambda self: self.sensor('scan'))
+    imu = property(lambda self: self.sensor('imu'))
+    cameras = property(lambda self: [sensor for sensor in self.sensors if sensor.name == 'camera'])
 
     # --- commands and stepping ------------------------------------------------
     def command(self, v, w, now_ns):
@@ -60,19 +56,18 @@ class Robot(object):
             self.body.set_wheel_speeds(*speeds)
 
     def after_step(self):
-        self.odometry_source.update()
+        for sensor in self.sensors:
+            sensor.update()
 
     def reset(self):
         """Back to the spawn pose, at rest, odometry zeroed there."""
-        x, y, z, yaw = self.spawn_pose
         self.body.reset(self.spawn_pose)
         self.drive.reset()
         self.body.set_wheel_speeds(0.0, 0.0)
-        self.odometry_source.reset(x, y, yaw)
-        if self.imu:
-            self.imu.reset()
+        for sensor in self.sensors:
+            sensor.reset()
 
-    # --- readings ---------------------------------------------------------------
+    # --- readings, for tests and tools: the ROS edge reads the sensors ---------
     def truth(self):
         """((position, orientation), (linear, angular)) of base_footprint: its true
         pose in the world and its twist in its own frame."""
@@ -80,13 +75,10 @@ class Robot(object):
 
     def odometry(self, truth=None):
         """odom's (pose, twist), given the true ones if already read."""
-        return self.odometry_source.read(truth if truth is not None else self.truth())
+        return self.sensor('odom').source.read(truth if truth is not None else self.truth())
 
     def wheel_states(self):
         return self.body.wheel_states()
 
     def scan(self):
-        return self.lidar.scan()
-
-    def imu_reading(self, now_s):
-        return self.imu.read(now_s)
+        return self.lidar.read()

@@ -13,7 +13,6 @@ from .params import changed
 from .robot import Robot
 from .world import GROUND, World
 
-#: A model's state: pose ((x, y, z), (x, y, z, w)), linear and angular velocity (x, y, z).
 WORLD_FRAMES = ('', 'world')  # how Gazebo's requests name the world frame
 
 
@@ -37,7 +36,7 @@ class Simulation(object):
         self.now_ns = 0
 
     def add_robot(self, name, model, pose, model_name=None):
-        """A Robot of `model` (a robot_model.RobotModel) at `pose` (x, y, z, yaw),
+        """A Robot of `model` (a robot_model.RobotModel) at `pose` (position, orientation),
         or ValueError naming it when its name is taken or the pose is not free.
         Its model name (Gazebo's) is `model_name`, else its name, else its URDF's."""
         if name in self.robots:
@@ -51,7 +50,7 @@ class Simulation(object):
                                     config.wheel_torque, config.ground_friction, config.caster_friction,
                                     "position (%s's)" % name if name else 'x_pos/y_pos')
         rng = np.random.default_rng(self._seeds.spawn(1)[0])
-        robot = self.robots[name] = Robot(name, model, body, config, tuple(pose), rng)
+        robot = self.robots[name] = Robot(name, model, body, config, pose, rng)
         robot.model_name = model_name
         return robot
 
@@ -204,7 +203,7 @@ class Simulation(object):
 
 
 def build(config, obstacles, robots, world_class=World):
-    """A Simulation with `robots`, a list of (name, model, pose), or the error of
+    """A Simulation with `robots`, a list of (name, model, pose (position, orientation)), or the error of
     the first that cannot be placed, with nothing left open."""
     simulation = Simulation(config, obstacles, world_class, cameras=any(model.cameras for _, model, _ in robots))
     try:

@@ -95,6 +95,26 @@ def test_the_angular_correction_scales_odometry_at_once(ros_port, processes):
     assert measured == pytest.approx(1.5, abs=0.08), 'odom / truth turn rate %.3f after the change' % measured
 
 
+def test_the_imu_covariance_follows_dynparam(ros_port, processes):
+    """One Config: after `dynparam set /tb3_sim imu_gyro_noise`, the IMU messages'
+    angular-velocity covariance is the new noise squared (the node once kept its
+    own frozen copy of the config, and the covariance kept the old noise)."""
+    processes.start_master('roscore', ros_port)
+    start_simulator(processes)
+
+    def covariance(field):
+        shown = run(['rostopic', 'echo', '-n', '1', '/imu/%s_covariance' % field], TIMEOUT)
+        assert shown.returncode == 0, shown.stdout
+        return float(shown.stdout.strip('[]\n-').split(',')[0])
+    assert covariance('angular_velocity') == pytest.approx(2e-3 ** 2)  # the realistic profile's 2e-3 rad/s
+    for name, value, field in (('imu_gyro_noise', 0.01, 'angular_velocity'),
+                               ('imu_accel_noise', 0.2, 'linear_acceleration')):
+        done = run(['rosrun', 'dynamic_reconfigure', 'dynparam', 'set', '/tb3_sim', name, str(value)], TIMEOUT)
+        assert done.returncode == 0, done.stdout
+        assert wait_until(lambda: covariance(field) == pytest.approx(value ** 2), TIMEOUT), \
+            '%s covariance %r after %s = %g' % (field, covariance(field), name, value)
+
+
 def test_make_demo_calibrate_shrinks_the_odometry_error(tmp_path):
     """The walkthrough: our scripts reach their targets on odometry, the
     corrections come out near 1, and odom_out_and_back.py's odometry ends

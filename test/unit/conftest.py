@@ -32,6 +32,7 @@ def world_factory(burger_urdf):
     """make(time_step, settle, spawn_pose, obstacles): the RobotBody of a Burger in
     a World (its `world`) left to settle for `settle` s of sim time; every world
     is closed after the test."""
+    from tb3_sim_nav.frames import planar
     from tb3_sim_nav.robot_model import load_model
     from tb3_sim_nav.world import World
     model = load_model(str(burger_urdf))
@@ -40,7 +41,7 @@ def world_factory(burger_urdf):
     def make(time_step, settle, spawn_pose=(0.0, 0.0, 0.0, 0.0), obstacles=()):
         world = World(time_step, obstacles)
         worlds.append(world)
-        robot = world.add_robot(model.urdf_text, spawn_pose, casters=model.casters)
+        robot = world.add_robot(model.urdf_text, planar(*spawn_pose), casters=model.casters)
         for _ in range(int(round(settle / time_step))):
             world.step()
         return robot

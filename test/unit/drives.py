@@ -13,6 +13,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from tb3_sim_nav.frames import planar, yaw_of
 from tb3_sim_nav.params import resolve
 from tb3_sim_nav.robot_model import load_model
 from tb3_sim_nav.simulation import build
@@ -33,14 +34,9 @@ CONTROL_PERIOD_NS = 30000000  # a command every 30 ms of sim time
 Drive = namedtuple('Drive', 'times truth odom ranges angle_min angle_increment range_min range_max scan_pose')
 
 
-def _yaw(orientation):
-    x, y, z, w = orientation
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
 def _pose(pose):
     (x, y, _), orientation = pose
-    return x, y, _yaw(orientation)
+    return x, y, yaw_of(orientation)
 
 
 def record_drive(world, start, waypoints, profile='realistic', seed=7, speed=0.18, turn_speed=1.0,
@@ -52,7 +48,7 @@ def record_drive(world, start, waypoints, profile='realistic', seed=7, speed=0.1
     config = resolve(lambda name, default: values.get(name, default))
     obstacles = load_world(world, str(REPO / 'worlds')).obstacles
     model = load_model(str(REPO / 'urdf' / 'turtlebot3_burger.urdf'))
-    simulation = build(config, obstacles, [('', model, (start[0], start[1], 0.0, start[2]))])
+    simulation = build(config, obstacles, [('', model, planar(start[0], start[1], 0.0, start[2]))])
     try:
         robot = simulation.robots['']
         lidar = robot.lidar

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from tb3_sim_nav.camera import DEFAULT_MAX_WIDTH, camera_size
+from tb3_sim_nav.frames import IDENTITY
 from tb3_sim_nav.params import resolve
 from tb3_sim_nav.robot_model import load_model
 from tb3_sim_nav.simulation import build
@@ -28,7 +29,7 @@ def make(repo):
         parameters.setdefault('model', model.urdf_file)
         parameters.setdefault('scan_noise', 0.0)
         config = resolve(lambda key, default: parameters.get(key, default))
-        simulation = build(config, obstacles, [('', model, (0.0, 0.0, 0.0, 0.0))])
+        simulation = build(config, obstacles, [('', model, IDENTITY)])
         made.append(simulation)
         for _ in range(50):
             simulation.step()

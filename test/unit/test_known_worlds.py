@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 import yaml
 
+from tb3_sim_nav.frames import planar
 from tb3_sim_nav.params import resolve
 from tb3_sim_nav.robot_model import TURTLEBOT3_MODELS, load_model
 from tb3_sim_nav.simulation import build
@@ -57,7 +58,7 @@ def make(repo):
     def make_simulation(robots, obstacles, model='burger'):
         urdf = str(repo / 'urdf' / ('turtlebot3_%s.urdf' % model))
         config = resolve(lambda name, default: {'model': urdf, 'scan_noise': 0.0}.get(name, default))
-        simulation = build(config, obstacles, [(name, load_model(urdf), pose) for name, pose in robots])
+        simulation = build(config, obstacles, [(name, load_model(urdf), planar(*pose)) for name, pose in robots])
         made.append(simulation)
         return simulation
     yield make_simulation

@@ -259,19 +259,41 @@ def test_tracking_holds_5_cm_over_the_loop_while_odometry_drifts(world, loop):
     assert np.all((updates[:, 3] >= 500) & (updates[:, 3] <= 3000)) and np.median(updates[:, 3]) == 500
 
 
-@pytest.mark.parametrize('direction, turn', [(0, 30), (135, -30), (200, 30), (270, -30)])
-def test_recovery_from_half_a_metre_and_30_degrees_off(world, loop, direction, turn):
-    angle = math.radians(direction)
-    start = loop.truth[0] + (0.5 * math.cos(angle), 0.5 * math.sin(angle), math.radians(turn))
-    amcl = Amcl(AmclConfig(), *world, seed=direction)
-    amcl.initialise(start, RVIZ_COVARIANCE)  # as rviz's 2D Pose Estimate sends it
-    errors, _ = run(amcl, loop)
+#: Where rviz's 2D Pose Estimate may put a filter: half a metre off in four directions, turned 30 degrees.
+RECOVERY_STARTS = [(0, 30), (135, -30), (200, 30), (270, -30)]
+
+
+@pytest.fixture(scope='module')
+def recoveries(world, loop):
+    """{(direction, turn): tf errors at every scan} of a filter started there off the loop's start (seeded by
+    its direction), with rviz's covariance."""
+    runs = {}
+    for direction, turn in RECOVERY_STARTS:
+        angle = math.radians(direction)
+        amcl = Amcl(AmclConfig(), *world, seed=direction)
+        amcl.initialise(loop.truth[0] + (0.5 * math.cos(angle), 0.5 * math.sin(angle), math.radians(turn)),
+                        RVIZ_COVARIANCE)
+        runs[direction, turn] = run(amcl, loop)[0]
+    return runs
+
+
+# The bounds come from 120 starts (these four, and 116 of random direction, turn and seed; 2026-11-23, the
+# simulator's rays meeting the shapes' exact surfaces from the link poses of the current step). Within 20 cm
+# after 0.36 m driven at the median and 3.3 m at worst. The last centimetres take longer, as a likelihood
+# this flat pulls a cloud in slowly: at the end of the 13.6 m loop 2.0 cm at the median (mean 2.2), 3.8 cm
+# at the 95th percentile, 6.9 cm at worst, 2 of 120 over 5 cm. (With pybullet's rays, up to 6 mm short of
+# a cylinder: 40 starts, median 2.2 cm, worst 5.3 cm, 1 of 40 over 5 cm: the same filter.)
+@pytest.mark.parametrize('direction, turn', RECOVERY_STARTS)
+def test_recovery_from_half_a_metre_and_30_degrees_off(recoveries, loop, direction, turn):
+    errors = recoveries[direction, turn]
     assert errors[0] > 0.3
-    # Within 20 cm from a few metres on (30 random starts: at most 3.4 m); the last centimetres take
-    # longer, as a likelihood this flat pulls a cloud in slowly: under 10 cm after 1.7 m at the median
-    # but up to 9 m; under 5 cm at the end of the 13.6 m loop in all 30.
     assert after(errors, travelled(loop), 0.20) < 4.0  # metres driven
-    assert errors[-1] < 0.05
+    assert errors[-1] < 0.075  # past the worst of the 120
+
+
+def test_recoveries_end_within_3_5_cm_on_average(recoveries):
+    # Four starts drawn from those 120 average over 3.5 cm in 1.4 % of draws (bootstrap).
+    assert np.mean([errors[-1] for errors in recoveries.values()]) < 0.035
 
 
 def test_global_localization_in_the_house(house, house_drive):

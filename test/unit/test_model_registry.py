@@ -5,7 +5,7 @@ import math
 import pybullet
 import pytest
 
-from tb3_sim_nav.frames import compose, from_rpy, inverse, relative, rotate
+from tb3_sim_nav.frames import IDENTITY, compose, from_rpy, inverse, relative, rotate
 from tb3_sim_nav.model_files import ModelFileError, check_urdf, link_shapes, parse_sdf
 from tb3_sim_nav.params import resolve
 from tb3_sim_nav.robot_model import load_model
@@ -80,7 +80,7 @@ def simulation(burger_urdf):
     config = resolve(lambda name, default: dict(model=str(burger_urdf), scan_noise=0.0).get(name, default))
     pillar = Obstacle('cylinder', (0.15, 0.4), (2.0, 0.0, 0.2), 0.0, (0, 1, 0, 1), 'pillar')
     made = build(config, [pillar, Obstacle('box', (0.1, 1.0, 0.4), (-1.0, 1.0, 0.2), 0.0, (1, 1, 1, 1))],
-                 [('', load_model(str(burger_urdf)), (0.0, 0.0, 0.0, 0.0))])
+                 [('', load_model(str(burger_urdf)), IDENTITY)])
     for _ in range(20):
         made.step()
     yield made
@@ -159,4 +159,4 @@ def test_reset_world_puts_spawned_objects_back_too(simulation):
 def test_a_robot_deleted_is_gone_from_the_world(simulation):
     simulation.delete_model('turtlebot3_burger')
     assert simulation.robots == {} and 'turtlebot3_burger' not in simulation.model_names()
-    assert pybullet.getNumBodies(physicsClientId=simulation.world.client) == 3  # the ground and two obstacles
+    assert simulation.world.p.getNumBodies() == 3  # the ground and two obstacles

@@ -3,7 +3,7 @@ import math
 
 import pytest
 
-from tb3_sim_nav.pacing import MAX_LAG, Pacer, Schedule
+from tb3_sim_nav.pacing import MAX_LAG, Pacer, Schedule, WallShare
 
 DT = 1.0 / 200   # sim seconds per physics step
 COMPUTE = 0.001  # wall seconds one physics step takes
@@ -30,7 +30,7 @@ def pacer(factor, wall, **kwargs):
 
 
 def run_steps(pace, wall, first, count, compute=COMPUTE):
-    """Steps first..first+count-1 as ros_node's loop does; the sleep (or None) before each."""
+    """Steps first..first+count-1 as the node's step loop does; the sleep (or None) before each."""
     slept = []
     for step in range(first, first + count):
         before = len(wall.sleeps)
@@ -172,3 +172,37 @@ def test_schedule_recovers_after_time_jump_backwards():
     after_reset = due_steps(schedule, range(1, 201))  # time starts over: 1 s
     assert after_reset[:1] == [1]
     assert len(after_reset) == 30
+
+
+def frames_rendered(cost, frames=150, rate=15.0, share=0.5):
+    """(frames rendered, wall seconds taken) of `frames` camera frames due at `rate` (Hz
+    of sim time, paced at real time) when each costs `cost` wall seconds and the
+    camera may take `share` of the wall time."""
+    wall = FakeWall()
+    budget = WallShare(share, wall_clock=wall.clock)
+    rendered = 0
+    for frame in range(frames):
+        wall.now = max(wall.now, 1000.0 + frame / rate)  # paced: wait for the frame's time
+        if budget.allows():
+            wall.now += cost
+            budget.spent(cost)
+            rendered += 1
+    return rendered, wall.now - 1000.0
+
+
+def test_a_camera_that_has_time_renders_every_frame():
+    assert frames_rendered(0.030) == (150, pytest.approx(10.0, abs=0.1))  # 30 ms of every 67 ms
+
+
+def test_a_camera_short_of_time_drops_frames_to_keep_to_its_share_of_the_wall_time():
+    # 0.5 s a frame (llvmpipe on a loaded machine): one frame a second, and the world keeps real time.
+    rendered, took = frames_rendered(0.5)
+    assert rendered == 10 and took == pytest.approx(10.0, abs=0.5)
+    rendered, took = frames_rendered(0.1, share=0.25)
+    assert rendered * 0.1 == pytest.approx(0.25 * took, abs=0.1)
+
+
+def test_a_wall_share_must_be_a_share():
+    for share in (0.0, -0.5, 1.5, math.nan):
+        with pytest.raises(ValueError, match='share'):
+            WallShare(share)

@@ -4,7 +4,8 @@ import math
 import pybullet
 import pytest
 
-from tb3_sim_nav.diff_drive import quaternion_to_yaw, wheel_speeds
+from tb3_sim_nav.diff_drive import wheel_speeds
+from tb3_sim_nav.frames import planar, yaw_of
 from tb3_sim_nav.params import PARAMETERS, resolve
 from tb3_sim_nav.robot_model import load_model, read_drive_geometry
 from tb3_sim_nav.simulation import build
@@ -68,7 +69,7 @@ def make_sim(burger_urdf):
         assert set(overrides) <= {parameter.name for parameter in PARAMETERS}, overrides
         overrides.setdefault('model', str(burger_urdf))
         config = resolve(lambda name, default: overrides.get(name, default))
-        sim = build(config, obstacles, [('', model, (config.x_pos, config.y_pos, config.z_pos, config.yaw))])
+        sim = build(config, obstacles, [('', model, planar(config.x_pos, config.y_pos, config.z_pos, config.yaw))])
         sims.append(sim)
         return OneRobot(sim)
     yield make
@@ -98,7 +99,7 @@ def out_and_back(sim):
 def pose(position_orientation):
     """(x, y, yaw)."""
     position, orientation = position_orientation
-    return position[0], position[1], quaternion_to_yaw(*orientation)
+    return position[0], position[1], yaw_of(orientation)
 
 
 def angle_between(a, b):

@@ -10,6 +10,7 @@ import math
 
 import pytest
 
+from tb3_sim_nav.frames import IDENTITY
 from tb3_sim_nav.params import PARAMETERS, resolve
 from tb3_sim_nav.robot_model import load_model
 from tb3_sim_nav.simulation import build
@@ -37,7 +38,7 @@ def stop_and_watch(burger_urdf, profile, manoeuvre, stop, offset):
         overrides['cmd_vel_timeout'] = 0.5
     assert set(overrides) <= {parameter.name for parameter in PARAMETERS}
     config = resolve(lambda name, default: overrides.get(name, default))
-    sim = build(config, (), [('', load_model(str(burger_urdf)), (0.0, 0.0, 0.0, 0.0))])
+    sim = build(config, (), [('', load_model(str(burger_urdf)), IDENTITY)])
     try:
         robot = sim.robots['']
         v, w, seconds = MANOEUVRES[manoeuvre]

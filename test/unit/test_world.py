@@ -5,7 +5,8 @@ import numpy as np
 import pybullet
 import pytest
 
-from tb3_sim_nav.diff_drive import quaternion_to_yaw, wheel_speeds
+from tb3_sim_nav.diff_drive import wheel_speeds
+from tb3_sim_nav.frames import yaw_of
 from tb3_sim_nav.robot_model import read_drive_geometry
 
 STEP = 1.0 / 200
@@ -36,7 +37,7 @@ def pose(robot):
     """(x, y, z, roll, pitch, yaw) of base_footprint."""
     position, orientation = robot.base_pose()
     roll, pitch, _ = pybullet.getEulerFromQuaternion(orientation)
-    return tuple(position) + (roll, pitch, quaternion_to_yaw(*orientation))
+    return tuple(position) + (roll, pitch, yaw_of(orientation))
 
 
 def angle_between(a, b):
@@ -44,8 +45,8 @@ def angle_between(a, b):
 
 
 def link_index(robot, name):
-    for index in range(pybullet.getNumJoints(robot.id, physicsClientId=robot.world.client)):
-        info = pybullet.getJointInfo(robot.id, index, physicsClientId=robot.world.client)
+    for index in range(robot.p.getNumJoints(robot.id)):
+        info = robot.p.getJointInfo(robot.id, index)
         if info[12].decode() == name:
             return index
     raise KeyError(name)
@@ -56,7 +57,7 @@ def test_robot_settles_level_on_wheels_and_caster(make_world):
     x, y, z, roll, pitch, _yaw = pose(robot)
     assert abs(z) < 0.002
     assert abs(math.degrees(roll)) < 1.0 and abs(math.degrees(pitch)) < 1.0
-    contacts = pybullet.getContactPoints(robot.id, robot.world.plane, physicsClientId=robot.world.client)
+    contacts = robot.p.getContactPoints(robot.id, robot.world.plane)
     touching = {contact[3] for contact in contacts}
     expected = {link_index(robot, 'wheel_left_link'), link_index(robot, 'wheel_right_link'),
                 link_index(robot, 'caster_back_link')}

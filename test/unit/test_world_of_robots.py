@@ -6,6 +6,7 @@ import math
 import pybullet
 import pytest
 
+from tb3_sim_nav.frames import planar
 from tb3_sim_nav.params import resolve
 from tb3_sim_nav.robot_model import load_model
 from tb3_sim_nav.simulation import build
@@ -27,7 +28,7 @@ def make(burger_urdf):
         parameters.setdefault('model', str(burger_urdf))
         parameters.setdefault('scan_noise', 0.0)
         config = resolve(lambda name, default: parameters.get(name, default))
-        simulation = build(config, (), [(name, model, (x, y, 0.0, yaw)) for name, (x, y, yaw) in robots])
+        simulation = build(config, (), [(name, model, planar(x, y, 0.0, yaw)) for name, (x, y, yaw) in robots])
         made.append(simulation)
         return simulation
     yield make_simulation
@@ -73,7 +74,7 @@ def test_robots_get_collision_groups_of_their_own_up_to_the_limit(make):
     groups = [robot.body.group for robot in simulation.robots.values()]
     assert len(set(groups)) == MAX_ROBOTS
     with pytest.raises(ValueError, match='robot one_too_many: a world holds at most %d robots' % MAX_ROBOTS):
-        simulation.add_robot('one_too_many', simulation.robots['r0'].model, (0.0, 5.0, 0.0, 0.0))
+        simulation.add_robot('one_too_many', simulation.robots['r0'].model, planar(0.0, 5.0))
 
 
 def test_a_robot_driven_alone_moves_alone(make):
@@ -112,15 +113,15 @@ def test_reset_world_puts_each_robot_back_at_its_own_spawn_pose(make):
 def test_a_robot_spawned_inside_another_is_refused_naming_both(make):
     simulation = make([('a', (0.0, 0.0, 0.0))])
     with pytest.raises(ValueError, match=r"robot b: the spawn pose \(0.05, 0.00\) puts it inside robot a"):
-        simulation.add_robot('b', simulation.robots['a'].model, (0.05, 0.0, 0.0, 0.0))
+        simulation.add_robot('b', simulation.robots['a'].model, planar(0.05, 0.0))
     assert list(simulation.robots) == ['a']
-    simulation.add_robot('b', simulation.robots['a'].model, (1.0, 0.0, 0.0, 0.0))  # the world goes on
+    simulation.add_robot('b', simulation.robots['a'].model, planar(1.0, 0.0))  # the world goes on
 
 
 def test_two_robots_with_one_name_are_refused(make):
     simulation = make([('a', (0.0, 0.0, 0.0))])
     with pytest.raises(ValueError, match="two robots are named 'a'"):
-        simulation.add_robot('a', simulation.robots['a'].model, (1.0, 0.0, 0.0, 0.0))
+        simulation.add_robot('a', simulation.robots['a'].model, planar(1.0, 0.0))
 
 
 def connected_clients():

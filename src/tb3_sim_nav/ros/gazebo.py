@@ -8,9 +8,11 @@ A request that cannot be met gets success false and a status_message that
 says why; nothing is changed then.
 
 Every change to the world runs in the step loop's thread, between steps
-(node.run_in_loop): pybullet is not to be called from two threads, and a
+(loop.Requests): pybullet is not to be called from two threads, and a
 spawned robot's robot_state_publisher must be started from the thread that
-lives as long as the node.
+lives as long as the node. It is handed what it serves from, not the node:
+the simulation, the step loop's requests, the fleet of robot interfaces,
+the world's markers and the pacer.
 """
 import math
 
@@ -61,11 +63,12 @@ def _finite(*values):
 
 class GazeboInterface(object):
 
-    def __init__(self, node):
-        self.node = node
-        self.sim = node.sim
-        self.model_states = node.publishers.advertise('gazebo/model_states', ModelStates)
-        self.link_states = node.publishers.advertise('gazebo/link_states', LinkStates)
+    def __init__(self, sim, publishers, requests, fleet, markers, pacer, warn):
+        """`warn(kind, text)`: a throttled warning."""
+        self.sim, self.requests, self.fleet, self.markers, self.pacer = sim, requests, fleet, markers, pacer
+        self._warn = warn
+        self.model_states = publishers.advertise('gazebo/model_states', ModelStates)
+        self.link_states = publishers.advertise('gazebo/link_states', LinkStates)
         rospy.Subscriber('gazebo/set_model_state', ModelState, self._on_set_model_state, queue_size=10)
         for name, kind, handler in (
                 ('get_model_state', GetModelState, self._get_model_state),
@@ -105,11 +108,11 @@ class GazeboInterface(object):
     def _answer(self, response, work):
         """`response` with success and status_message, after `work()` in the step loop."""
         try:
-            status = self.node.run_in_loop(work)
+            status = self.requests.run(work)
             response.success, response.status_message = True, status or ''
         except (ModelStateError, ModelFileError, ModelError, ValueError) as error:
             response.success, response.status_message = False, str(error)
-            self.node.warn_throttled('gazebo request', 'gazebo: %s' % error)
+            self._warn('gazebo request', 'gazebo: %s' % error)
         return response
 
     def _get_model_state(self, request):
@@ -128,7 +131,7 @@ class GazeboInterface(object):
         pose, twist = _pose(state.pose), state.twist
         self.sim.set_model_state(state.model_name, pose, _vector(twist.linear), _vector(twist.angular),
                                  state.reference_frame)
-        self.node.world_changed()
+        self.markers.changed()
         return 'SetModelState: set model state done'
 
     def _set_model_state(self, request):
@@ -136,9 +139,9 @@ class GazeboInterface(object):
 
     def _on_set_model_state(self, state):
         try:
-            self.node.run_in_loop(lambda: self._set(state))
+            self.requests.run(lambda: self._set(state))
         except (ModelStateError, ValueError) as error:
-            self.node.warn_throttled('gazebo set_model_state topic', 'gazebo/set_model_state: %s' % error)
+            self._warn('gazebo set_model_state topic', 'gazebo/set_model_state: %s' % error)
 
     def _spawn_pose(self, request):
         """A spawn request's initial_pose in the world (a zero quaternion: no rotation, as Gazebo reads it)."""
@@ -158,10 +161,10 @@ class GazeboInterface(object):
             namespace = request.robot_namespace.strip('/')
             if namespace:  # a TurtleBot3 (it drives: wheels and limits) becomes a robot with its topics
                 model = load_model_text(request.model_xml, request.model_name)
-                self.node.spawn_robot(namespace, model, pose, request.model_name)
+                self.fleet.spawn(namespace, model, pose, request.model_name)
                 return 'SpawnModel: robot %s spawned with the topics of namespace /%s' % (request.model_name, namespace)
             self.sim.spawn_object(request.model_name, None, pose, urdf.static, urdf=request.model_xml)
-            self.node.world_changed()
+            self.markers.changed()
             return 'SpawnModel: successfully spawned model %s' % request.model_name
         return self._answer(SpawnModelResponse(), work)
 
@@ -176,7 +179,7 @@ class GazeboInterface(object):
                 (link,) = model.links
                 shapes = [(shape, False) for shape in link.collisions] + [(shape, True) for shape in link.visuals]
                 self.sim.spawn_object(request.model_name, shapes, pose, False, link.mass, frame_offset=link.pose)
-            self.node.world_changed()
+            self.markers.changed()
             return 'SpawnModel: successfully spawned model %s' % request.model_name
         return self._answer(SpawnModelResponse(), work)
 
@@ -184,8 +187,8 @@ class GazeboInterface(object):
         def work():
             robot = self.sim.delete_model(request.model_name)
             if robot is not None:
-                self.node.forget_robot(robot)
-            self.node.world_changed()
+                self.fleet.forget(robot)
+            self.markers.changed()
             return 'DeleteModel: successfully deleted model %s' % request.model_name
         return self._answer(DeleteModelResponse(), work)
 
@@ -221,8 +224,8 @@ class GazeboInterface(object):
 
         def work():
             step = self.sim.step_ns * 1e-9
-            factor = self.node.pacer.factor
-            response.time_step, response.pause = step, self.node.pacer.paused
+            factor = self.pacer.factor
+            response.time_step, response.pause = step, self.pacer.paused
             response.max_update_rate = factor / step
             response.gravity.x, response.gravity.y, response.gravity.z = self.sim.world.gravity
             response.ode_config = ODEPhysics(**ODE_DEFAULTS)
@@ -237,13 +240,13 @@ class GazeboInterface(object):
             if not _finite(step, rate, *gravity) or not step > 0.0 or rate < 0.0:
                 raise ModelStateError('time_step %r must be > 0, max_update_rate %r >= 0, gravity %s finite'
                                       % (step, rate, gravity))
-            slowest = self.node.fastest_output()
+            slowest = self.fleet.fastest_output()
             if 1.0 / step < slowest[1]:
                 raise ModelStateError('time_step %g s gives %g physics steps per second, fewer than ~%s (%g Hz)'
                                       % (step, 1.0 / step, slowest[0], slowest[1]))
             self.sim.set_time_step(step)
             self.sim.world.set_gravity(gravity)
-            self.node.set_real_time_factor(rate * step)
+            self.pacer.set_factor(rate * step)
             rospy.loginfo('set_physics_properties: time step %g s, real-time factor %g (0: as fast as possible), '
                           'gravity %s', step, rate * step, gravity)
             return 'SetPhysicsProperties: done (ode_config is not used here)'

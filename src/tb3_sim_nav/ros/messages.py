@@ -90,11 +90,16 @@ def fill_scan(message, stamp, ranges):
 def imu(frame, gyro_noise, accel_noise):
     message = Imu()
     message.header.frame_id = frame
-    # A zero covariance would claim a perfect sensor: keep a floor.
     message.orientation_covariance = diagonal([1e-6] * 3)
+    imu_noise(message, gyro_noise, accel_noise)
+    return message
+
+
+def imu_noise(message, gyro_noise, accel_noise):
+    """The covariances of an IMU whose noise has these standard deviations; a zero
+    covariance would claim a perfect sensor: keep a floor."""
     message.angular_velocity_covariance = diagonal([max(gyro_noise ** 2, 1e-8)] * 3)
     message.linear_acceleration_covariance = diagonal([max(accel_noise ** 2, 1e-6)] * 3)
-    return message
 
 
 def fill_imu(message, stamp, reading):
