@@ -94,7 +94,12 @@ class Body(object):
         position, orientation = compose(pose, self.frame_offset)
         self.p.resetBasePositionAndOrientation(self.id, position, orientation)
         self.p.resetBaseVelocity(self.id, linear, angular)
+        self.wake()
         self.world.moved(self)
+
+    def wake(self):
+        """Simulate it from this step on even if it slept (after a teleport, or when gravity changed)."""
+        self.p.changeDynamics(self.id, -1, activationState=self.p.ACTIVATION_STATE_WAKE_UP)
 
     def remove(self):
         self.p.removeBody(self.id)
@@ -148,8 +153,16 @@ class RobotBody(Body):
         mode are. A stopped motor is a servo at speed 0: holding the wheel's angle
         instead fights the contacts' friction and can spin a stopped robot up
         (doc/design.md, "Still means still")."""
-        self.p.setJointMotorControlArray(self.id, self.wheels, self.p.VELOCITY_CONTROL,
-                                         targetVelocities=[left, right], forces=[self.wheel_torque] * 2)
+        p = self.p
+        p.setJointMotorControlArray(self.id, self.wheels, p.VELOCITY_CONTROL,
+                                    targetVelocities=[left, right], forces=[self.wheel_torque] * 2)
+        # A robot whose motors are stopped may sleep once Bullet finds it at rest
+        # (2 s below its motion threshold): it then costs no solver time and does
+        # not creep, and a body that touches it wakes it. A robot whose wheels
+        # turn never sleeps, however slowly it goes. Ten robots standing: 31
+        # instead of 470 us a physics step (2026-11-24, this VM).
+        p.changeDynamics(self.id, -1, activationState=p.ACTIVATION_STATE_ENABLE_SLEEPING if left == right == 0.0
+                         else p.ACTIVATION_STATE_DISABLE_SLEEPING | p.ACTIVATION_STATE_WAKE_UP)
 
     def reset(self, pose):
         """Put the robot at `pose`, at rest, wheels at angle 0."""

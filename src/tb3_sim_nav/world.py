@@ -251,6 +251,8 @@ class World(object):
     def set_gravity(self, gravity):
         self.gravity = tuple(gravity)
         self.p.setGravity(*self.gravity)
+        for body in getattr(self, 'robots', ()):  # a sleeping robot would not feel it
+            body.wake()
 
     def set_time_step(self, seconds):
         self.time_step = seconds

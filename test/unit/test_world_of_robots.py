@@ -87,9 +87,10 @@ def test_a_robot_driven_alone_moves_alone(make):
     assert math.dist(xy_yaw(simulation.robots['b'])[:2], before[:2]) < 1e-4
 
 
-def test_a_robot_driven_into_a_standing_one_pushes_it_without_going_into_it(make):
+@pytest.mark.parametrize('standing', [0.5, 3.0])  # 3 s: b sleeps (Bullet's 2 s at rest), as parked robots do
+def test_a_robot_driven_into_a_standing_one_pushes_it_without_going_into_it(make, standing):
     simulation = make([('a', (0.0, 0.0, 0.0)), ('b', (0.6, 0.0, math.pi))])
-    settle(simulation)
+    settle(simulation, standing)
     simulation.robots['a'].command(0.2, 0.0, simulation.now_ns)
     gaps = []
     for _ in range(400):  # 4 s: 0.8 m asked for, 0.6 m between them
@@ -97,6 +98,24 @@ def test_a_robot_driven_into_a_standing_one_pushes_it_without_going_into_it(make
         gaps.append(xy_yaw(simulation.robots['b'])[0] - xy_yaw(simulation.robots['a'])[0])
     assert min(gaps) >= 2 * FRONT_EXTENT - PENETRATION
     assert gaps[-1] < 2 * FRONT_EXTENT + 0.02  # it did reach b, and pushes it (b's caster does not grip)
+
+
+def test_a_parked_robot_sleeps_and_wakes_when_commanded_and_a_slow_one_never_sleeps(make):
+    """A robot whose motors stopped sleeps after 2 s at rest (bodies.py): its
+    velocity is then exactly zero. A command wakes it; wheels turning however
+    slowly keep it awake."""
+    simulation = make([('a', (0.0, 0.0, 0.0)), ('b', (0.0, 1.0, 0.0))])
+    settle(simulation, 3.0)
+    for robot in simulation.robots.values():
+        linear, angular = robot.body.base_velocity()
+        assert tuple(linear) + tuple(angular) == (0.0,) * 6, robot.name
+    a, b = simulation.robots['a'], simulation.robots['b']
+    for _ in range(100):  # 10 s at `rostopic pub -r 10`: a at 0.2 m/s, b at 0.01 m/s
+        a.command(0.2, 0.0, simulation.now_ns)
+        b.command(0.01, 0.0, simulation.now_ns)
+        settle(simulation, 0.1)
+    assert xy_yaw(a)[0] == pytest.approx(2.0, abs=0.1)
+    assert xy_yaw(b)[0] == pytest.approx(0.1, abs=0.01)
 
 
 def test_reset_world_puts_each_robot_back_at_its_own_spawn_pose(make):
