@@ -126,10 +126,14 @@ def test_a_reader_that_keeps_up_gets_every_message_in_order(pairs):
 def test_a_stopped_reader_never_blocks_the_writer(pairs):
     connection, _reader = pairs(max_messages=16)
     seq = write_until_backlogged(connection)
+    waiting, sent = connection.backlog, connection.stat_num_msg
     # Far past the socket's buffers and the backlog.
     never_blocks(lambda: [connection.write_data(message(seq + extra)) for extra in range(5000)])
     assert connection.backlog <= 16 + 1  # whole messages, and the one begun
-    assert connection.dropped >= 5000 - 17
+    # Each message was sent, dropped or waits; the kernel may take a few hundred
+    # more as its buffers grow (4689 dropped on a busy machine), no more.
+    assert (connection.stat_num_msg - sent) + connection.dropped + connection.backlog == waiting + 5000
+    assert connection.dropped >= 5000 // 2
 
 
 def test_a_stopped_reader_loses_whole_messages_oldest_first_and_then_gets_the_newest(pairs):
