@@ -1,4 +1,5 @@
-"""rays.StaticScene against distances worked out by hand: boxes, cylinders, spheres and the ground. No pybullet.
+"""rays.StaticScene against distances worked out by hand: boxes, cylinders, spheres and the ground; its culling
+against testing every ray against every shape. No pybullet.
 
 The lidar's ranges come from here for every still shape (world.World.cast),
 so they must be the exact surfaces: pybullet's convex cast stopped up to 6 mm
@@ -134,3 +135,49 @@ def test_distances_do_not_change_when_shapes_and_rays_turn_together(seed):
 def test_an_empty_scene_meets_only_the_ground():
     got = cast([], (0.0, 0.0, 0.5), [(1.0, 0.0, 0.0), (0.0, 0.6, -0.8)])
     assert got[0] == math.inf and got[1] == pytest.approx(0.625, abs=1e-12)
+
+
+def brute_force(shapes, origin, directions, length=LENGTH):
+    """The same casts with every ray tested against every shape (no culling), by rays' own exact tests."""
+    from tb3_sim_nav import rays
+    from tb3_sim_nav.frames import matrix
+    nearest = rays._ground(np.broadcast_to(origin, directions.shape), directions)
+    for kind, size, (position, orientation) in shapes:
+        turn = matrix(orientation)
+        start = np.broadcast_to(turn.T.dot(np.subtract(origin, position))[:, None], directions.T.shape)
+        test = {'box': rays._box, 'cylinder': rays._cylinder, 'sphere': rays._sphere}[kind]
+        half = np.broadcast_to(np.array(rays.halves(kind, size))[:, None], directions.T.shape)
+        nearest = np.minimum(nearest, test(start, turn.T.dot(directions.T), half))
+    return np.where(nearest <= length, nearest, np.inf)
+
+
+@pytest.mark.parametrize('seed', range(4))
+def test_culling_by_heading_keeps_every_ray_that_meets_a_shape(seed):
+    """Rays are tested only against the shapes whose shadow on the ground they
+    cross (a box's corners', a cylinder's or sphere's circle): every ray, of
+    every heading and slope, straight up and down too, from origins beside,
+    above and inside the shapes, finds what testing it against every shape finds."""
+    rng = np.random.default_rng(seed)
+    shapes = []
+    for _ in range(12):
+        kind = ('box', 'cylinder', 'sphere')[rng.integers(3)]
+        size = {'box': tuple(rng.uniform(0.05, 2.0, 3)), 'cylinder': tuple(rng.uniform(0.05, 1.0, 2)),
+                'sphere': (rng.uniform(0.05, 0.5),)}[kind]
+        shapes.append((kind, size, (tuple(rng.uniform(-1.5, 1.5, 2)) + (rng.uniform(0.0, 1.0),),
+                                    from_rpy(*rng.uniform(-math.pi, math.pi, 3)))))
+    directions = rng.normal(size=(720, 3)) * (1.0, 1.0, rng.uniform(0.0, 2.0))
+    directions[:100] = horizontal(np.sort(rng.uniform(-math.pi, math.pi, 100)))  # a lidar's: sorted, wrapping
+    directions[100:104] = [(0.0, 0.0, 1.0), (0.0, 0.0, -1.0), (-0.0, 0.0, 1.0), (1e-12, 0.0, -1.0)]
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    scene = StaticScene(shapes)
+    origins = np.array([np.append(rng.uniform(-2.0, 2.0, 2), rng.uniform(0.0, 1.5)) for _ in range(5)]
+                       + [shapes[0][2][0], shapes[1][2][0] + np.array((0.0, 0.0, 3.0))])  # inside, above a shape
+    got = scene.cast(origins, np.broadcast_to(directions, (len(origins),) + directions.shape).copy(), LENGTH)
+    hits = 0
+    for origin, found in zip(origins, got):
+        expected = brute_force(shapes, origin, directions)
+        hit = np.isfinite(expected)
+        assert np.array_equal(np.isfinite(found), hit)
+        assert np.abs(found[hit] - expected[hit]).max() < 1e-9
+        hits += hit.sum()
+    assert hits > 2000
