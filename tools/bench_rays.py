@@ -61,16 +61,16 @@ def run(src, casts):
 
 
 def agreement(before, after):
-    """(rays whose hit or miss differs, largest |difference| of the ranges both hit, rays)."""
-    differ, largest, rays = 0, 0.0, 0
+    """(rays whose hit or miss differs, |differences| of the ranges both hit, rays)."""
+    differ, gaps, rays = 0, [], 0
     for old, new in zip(before, after):
         for a, b in zip(old, new):
             rays += 1
             if isinstance(a, str) or isinstance(b, str):
                 differ += a != b
             else:
-                largest = max(largest, abs(a - b))
-    return differ, largest, rays
+                gaps.append(abs(a - b))
+    return differ, gaps, rays
 
 
 def main():
@@ -95,9 +95,10 @@ def main():
                  ' '.join('%.0f' % value for value in times[name])))
     if arguments.before:
         print('this / before: %.2f' % (statistics.median(times['this']) / statistics.median(times['before'])))
-        differ, largest, rays = agreement(ranges['before'], ranges['this'])
-        print('ranges: %d of %d rays differ in hit or miss; the hits differ by at most %.2g m'
-              % (differ, rays, largest))
+        differ, gaps, rays = agreement(ranges['before'], ranges['this'])
+        print('ranges: %d of %d rays differ in hit or miss; of the %d hits of both, %d differ by more than '
+              '0.01 mm, %d by more than 7 mm; at most %.2g m' % (differ, rays, len(gaps), sum(g > 1e-5 for g in gaps),
+                                                                sum(g > 0.007 for g in gaps), max(gaps + [0.0])))
 
 
 if __name__ == '__main__':

@@ -1,4 +1,4 @@
-"""Rays against the world's still part, in numpy: the ground and every static box, cylinder and sphere. No pybullet.
+"""Rays against boxes, cylinders, spheres and the ground, in numpy: the world's still shapes and its robots'. No pybullet.
 
 Why not pybullet's rayTestBatch for everything: it costs 0.4 us a ray even
 where nothing is, and Bullet tests a ray against a box or cylinder by a
@@ -17,25 +17,37 @@ against each shape's bounding sphere cost L x K x N rows of temporaries
 with ten robots (py-spy, 2026-11-24): 7.8 ms for the ten lidars of
 tools/bench_rays.py, 1.1-1.3 ms now, the same distances (2026-11-24).
 
+The robots are met here too: a Scene of each robot's URDF shapes in their
+links' frames is `placed` where the links are at each cast, and a shape's
+owner's rays pass through it (a lidar never sees its own robot). pybullet
+cast the rays that passed near another robot: 15.8 % of the simulator's CPU
+with ten robots close together (py-spy); with both, tools/bench_rays.py
+reads ten lidars at 218-225 us a scan, 1977-2068 us before (2026-11-24).
+
 What pybullet does and this keeps (measured against rayTestBatch in
 test_sensors.py): a ray that starts inside a shape does not hit that shape;
 the ground (the plane z = 0) is hit from above and from below. What it does
-not keep: Bullet's convex cast stops up to 6 mm short of a cylinder; here
-every shape is met at its exact surface (test_rays.py works the distances
-out by hand).
+not keep: Bullet's convex cast stops up to 6 mm short of a cylinder;
+loadURDF makes a URDF's cylinder a convex hull with a margin, up to 2 mm
+out of the cylinder (a lidar housing met 1 mm early face on, 4.5 mm at a
+slant); a ray that cuts a box's edge by 0.06 or 0.24 mm passed it there. So
+a ray that grazes a shape may meet it in one and not the other. Here every
+shape is met at its exact surface (test_rays.py works the distances out by
+hand).
 """
 import numpy as np
 
 from .frames import matrix
 
 KINDS = ('box', 'cylinder', 'sphere')
+NOBODY = -1       # the owner of a shape that is nobody's (an obstacle)
 TURN = 2.0 * np.pi
 MARGIN = 1e-9     # rad added to each side of a shape's span of headings: rounding, never a miss
 CORNERS = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
 
 
 def halves(kind, size):
-    """A shape's half extents as StaticScene keeps them: a box's half sizes; a cylinder's
+    """A shape's half extents as Scene keeps them: a box's half sizes; a cylinder's
     radius, radius, half length; a sphere's radius thrice."""
     return {'box': lambda: tuple(np.divide(size, 2.0)), 'cylinder': lambda: (size[0], size[0], size[1] / 2.0),
             'sphere': lambda: (size[0],) * 3}[kind]()
@@ -46,19 +58,29 @@ def rotations(orientations):
     return np.moveaxis(matrix(np.reshape(orientations, (-1, 4)).T), 2, 0)
 
 
-class StaticScene(object):
-    """The still shapes, as arrays: kind index (K), half extents (K x 3, `halves`),
-    centre (K x 3), world-from-shape rotation (K x 3 x 3), and their bounds (`_bound`)."""
+class Scene(object):
+    """Shapes as arrays: kind index (K), half extents (K x 3, `halves`), centre
+    (K x 3), world-from-shape rotation (K x 3 x 3), owner (K), and their bounds (`_bound`)."""
 
-    def __init__(self, shapes):
-        """`shapes`: (kind, size, pose) of each still shape in the world; size as
-        model_files.Shape's: box (x, y, z), cylinder (radius, length), sphere (radius,)."""
+    def __init__(self, shapes=(), owners=None):
+        """`shapes`: (kind, size, pose) of each shape; size as model_files.Shape's:
+        box (x, y, z), cylinder (radius, length), sphere (radius,). `owners`: each
+        one's owner (an int), else NOBODY's."""
         shapes = list(shapes)
         self.kinds = np.array([KINDS.index(kind) for kind, _, _ in shapes], dtype=int)
         self.halves = np.array([halves(kind, size) for kind, size, _ in shapes], dtype=float).reshape(-1, 3)
         self.centres = np.array([position for _, _, (position, _) in shapes], dtype=float).reshape(-1, 3)
         self.rotations = rotations([turn for _, _, (_, turn) in shapes])
+        self.owners = np.full(len(shapes), NOBODY) if owners is None else np.asarray(owners, dtype=int)
         self._bound()
+
+    @classmethod
+    def _of(cls, **arrays):
+        """A Scene of its arrays (kinds, halves, centres, rotations, owners), its bounds made anew."""
+        scene = cls.__new__(cls)
+        scene.__dict__.update(arrays)
+        scene._bound()
+        return scene
 
     def _bound(self):
         """The bounds of the shapes: a sphere about the centre (`radii`); on the
@@ -73,19 +95,35 @@ class StaticScene(object):
         edges = (self.rotations * self.halves[:, None, :])[:, :2, :]  # the half edges' shadows, K x 2 x 3
         self.corners = self.centres[:, None, :2] + np.einsum('kij,cj->kci', edges, CORNERS)
 
+    def placed(self, positions, orientations):
+        """This scene's shapes, each given in a frame of its own (K positions, K
+        quaternions), in the frames' frame: a body's shapes at its links' poses."""
+        turns = rotations(orientations)
+        centres = np.reshape(positions, (-1, 3)) + np.einsum('kij,kj->ki', turns, self.centres)
+        return Scene._of(kinds=self.kinds, halves=self.halves, centres=centres,
+                         rotations=np.matmul(turns, self.rotations), owners=self.owners)
+
+    def __add__(self, other):
+        """The shapes of both."""
+        scene = Scene.__new__(Scene)
+        for name in ('kinds', 'halves', 'centres', 'rotations', 'owners', 'radii', 'flat_radii', 'corners'):
+            setattr(scene, name, np.concatenate((getattr(self, name), getattr(other, name))))
+        return scene
+
     def reachable(self, origins, length):
         """How many shapes each origin (L x 3) can reach within `length`."""
         gaps = np.linalg.norm(self.centres[None, :, :] - np.asarray(origins)[:, None, :], axis=2)
         return (gaps - self.radii[None, :] <= length).sum(axis=1)
 
-    def cast(self, origins, directions, length):
-        """Distance along each ray to the first still surface within `length`, inf
-        where none: L x N, for L origins (L x 3; a lidar's beams share one) and the
-        unit `directions` (L x N x 3) of their N rays each."""
+    def cast(self, origins, directions, length, ignore=None):
+        """Distance along each ray to the first surface within `length`, inf where
+        none: L x N, for L origins (L x 3; a lidar's beams share one) and the unit
+        `directions` (L x N x 3) of their N rays each. Origin l's rays pass through
+        the shapes of owner ignore[l] (`ignore`: L ints; None: through none)."""
         count, beams = directions.shape[:2]
         rays = directions.reshape(-1, 3)
         nearest = _ground(np.repeat(origins, beams, axis=0), rays)
-        origin, shape, first, counts, order = self._spans(origins, directions, length)
+        origin, shape, first, counts, order = self._spans(origins, directions, length, ignore)
         # Into each shape's frame: the rows of its world-from-shape rotation. An
         # origin once a shape; its rays one by one, each kind's together. Arrays
         # are 3 x rays: numpy reduces K x 3 along its rows at 45 ns a row.
@@ -105,7 +143,7 @@ class StaticScene(object):
             _lower(nearest, *(np.concatenate(part) for part in zip(*met)))
         return np.where(nearest <= length, nearest, np.inf).reshape(count, beams)
 
-    def _spans(self, origins, directions, length):
+    def _spans(self, origins, directions, length, ignore):
         """The rays that cross the shadow on the ground of a shape within their
         origin's reach, as runs of each origin's rays sorted by heading: (origin,
         shape, first place in the run, count) of each such pair, and the order
@@ -119,6 +157,8 @@ class StaticScene(object):
         count, beams = directions.shape[:2]
         offsets = self.centres[None, :, :] - origins[:, None, :]  # L x K x 3
         near = np.linalg.norm(offsets, axis=2) - self.radii[None, :] <= length
+        if ignore is not None:
+            near &= self.owners[None, :] != np.asarray(ignore)[:, None]
         origin, shape = np.nonzero(near)
         offset = offsets[origin, shape]
         # Each origin's headings sorted, thrice a turn apart (a span may wrap
