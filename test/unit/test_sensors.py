@@ -353,6 +353,26 @@ def aside(direction, distance, count=8):
     return distance * (np.cos(angles)[:, None] * across + np.sin(angles)[:, None] * np.cross(direction, across))
 
 
+def cast_at(robot, targets, rng, count=20):
+    """(hits, rays within GRAZE_AGREE of pybullet's, rays) of rays_at_robots cast by
+    World.cast and by pybullet, `robot`'s own body passed through; where the two
+    differ, pybullet's answer must be World.cast's for the ray moved 2 mm aside."""
+    hits, agree, rays = 0, 0, 0
+    for origin, directions in rays_at_robots(rng, targets, count):
+        expected = every_ray_cast(robot, origin, directions, 3.5)
+        got = robot.world.cast([origin], directions[None], 3.5, [robot])[0]
+        hits += np.isfinite(expected).sum()
+        rays += len(expected)
+        same = agreeing(got, expected)
+        agree += same.sum()
+        for index in np.flatnonzero(~same):
+            moved = origin + aside(directions[index], 0.002)
+            found = robot.world.cast(moved, np.broadcast_to(directions[index], (len(moved), 1, 3)), 3.5,
+                                     [robot] * len(moved))[:, 0]
+            assert agreeing(found, expected[index]).any()
+    return hits, agree, rays
+
+
 @pytest.mark.parametrize('seed', range(4))
 def test_other_robots_are_met_where_pybullet_meets_them(world_factory, repo, seed):
     """Burgers and a Waffle standing, turned, tilted and in the air, their wheels
@@ -382,19 +402,7 @@ def test_other_robots_are_met_where_pybullet_meets_them(world_factory, repo, see
         world.step()
     # One put elsewhere since the last step, as set_model_state does: its links must follow.
     others[0].teleport(((0.5, -1.6, 0.2), from_rpy(0.3, 0.0, 1.0)))
-    hits, agree, rays = 0, 0, 0
-    for origin, directions in rays_at_robots(rng, others):
-        expected = every_ray_cast(robot, origin, directions, 3.5)
-        got = world.cast([origin], directions[None], 3.5, [robot])[0]
-        hits += np.isfinite(expected).sum()
-        rays += len(expected)
-        same = agreeing(got, expected)
-        agree += same.sum()
-        for index in np.flatnonzero(~same):  # pybullet's answer is the exact one's for the ray moved 2 mm aside
-            moved = origin + aside(directions[index], 0.002)
-            found = world.cast(moved, np.broadcast_to(directions[index], (len(moved), 1, 3)), 3.5,
-                               [robot] * len(moved))[:, 0]
-            assert agreeing(found, expected[index]).any()
+    hits, agree, rays = cast_at(robot, others, rng)
     assert hits > 0.6 * rays
     assert agree >= 0.99 * rays
 
@@ -421,3 +429,30 @@ def test_a_robot_with_a_mesh_is_met_by_pybullet(world_factory, burger_urdf, tmp_
     for origin, directions in rays_at_robots(rng, [meshed], count=5):
         expected = every_ray_cast(robot, origin, directions, 3.5)
         assert agreeing(robot.world.cast([origin], directions[None], 3.5, [robot])[0], expected).all()
+
+
+#: A spawned URDF model: its root's inertial frame off and turned (pybullet's base is there), a box and a
+#: lying cylinder on the root, a sphere on a turned arm.
+CART = '''<robot name="cart"><gazebo><static>%s</static></gazebo>
+<link name="body"><inertial><origin xyz="0.05 0.02 0.1" rpy="0.3 0.2 0.1"/><mass value="2"/>
+<inertia ixx="0.01" ixy="0.002" ixz="0.001" iyy="0.02" iyz="0.003" izz="0.03"/></inertial>
+<collision><origin xyz="0 0 0.15" rpy="0 0 0.3"/><geometry><box size="0.4 0.3 0.2"/></geometry></collision>
+<collision><origin xyz="0.3 0 0.1" rpy="1.5708 0 0"/><geometry><cylinder radius="0.08" length="0.3"/></geometry>
+</collision></link>
+<joint name="hinge" type="revolute"><parent link="body"/><child link="arm"/><origin xyz="-0.2 0 0.3" rpy="0 0.4 0"/>
+<axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+<link name="arm"><inertial><origin xyz="0 0 0.1"/><mass value="0.5"/>
+<inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial>
+<collision><origin xyz="0 0 0.15"/><geometry><sphere radius="0.07"/></geometry></collision></link></robot>'''
+
+
+@pytest.mark.parametrize('static', [True, False])
+def test_a_spawned_urdf_model_is_met_where_pybullet_meets_it(world_factory, static):
+    from tb3_sim_nav.frames import from_rpy
+    robot = world_factory(STEP, 0.0, (-2.0, 0.0, 0.0, 0.0))
+    cart = robot.world.add_urdf('cart', CART % str(static).lower(), ((0.5, 0.3, 0.0), from_rpy(0.0, 0.0, 0.7)), static)
+    robot.p.resetJointState(cart.id, cart.joints['hinge'], 0.6)
+    assert len(cart.collisions) == 3
+    hits, agree, rays = cast_at(robot, [cart], np.random.default_rng(1), count=10)
+    assert hits > 0.6 * rays
+    assert agree >= 0.99 * rays
