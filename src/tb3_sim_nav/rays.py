@@ -25,7 +25,7 @@ with ten robots close together (py-spy); with both, tools/bench_rays.py
 reads ten lidars at 218-225 us a scan, 1977-2068 us before (2026-11-24).
 
 What pybullet does and this keeps (measured against rayTestBatch in
-test_sensors.py): a ray that starts inside a shape does not hit that shape;
+test_world_rays.py): a ray that starts inside a shape does not hit that shape;
 the ground (the plane z = 0) is hit from above and from below. What it does
 not keep: Bullet's convex cast stops up to 6 mm short of a cylinder;
 loadURDF makes a URDF's cylinder a convex hull with a margin, up to 2 mm

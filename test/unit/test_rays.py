@@ -1,9 +1,10 @@
 """rays.Scene against distances worked out by hand: boxes, cylinders, spheres and the ground, a body's shapes placed
-at its links' frames, rays that pass through their owner's shapes. No pybullet.
+at its links' frames, rays that pass through their owner's shapes; its culling against every ray tested against
+every shape. No pybullet.
 
-The lidar's ranges come from here for every still shape (world.World.cast),
+The lidar's ranges come from here for every box, cylinder and sphere (world.World.cast),
 so they must be the exact surfaces: pybullet's convex cast stopped up to 6 mm
-short of a cylinder, a bias this must not copy. test_sensors.py checks the
+short of a cylinder, a bias this must not copy. test_world_rays.py checks the
 same casts against pybullet's, where the two agree.
 """
 import math
