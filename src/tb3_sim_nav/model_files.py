@@ -28,6 +28,8 @@ GAZEBO_MATERIALS = {'Gazebo/Red': (1.0, 0.0, 0.0, 1.0), 'Gazebo/Green': (0.0, 1.
                     'Gazebo/Yellow': (1.0, 1.0, 0.0, 1.0), 'Gazebo/Orange': (1.0, 0.5, 0.0, 1.0),
                     'Gazebo/Purple': (1.0, 0.0, 1.0, 1.0), 'Gazebo/Wood': (0.6, 0.45, 0.3, 1.0)}
 TRUE = ('true', '1')
+#: The attributes of a URDF shape that make its Shape's size.
+URDF_SIZES = {'box': ('size',), 'cylinder': ('radius', 'length'), 'sphere': ('radius',)}
 
 
 class ModelFileError(ValueError):
@@ -128,17 +130,43 @@ def check_urdf(text):
         raise ModelFileError('robot %r has no <link>' % robot.get('name'))
     for link in robot.findall('link'):
         for part in link.findall('visual') + link.findall('collision'):
-            geometry = part.find('geometry')
-            shapes = list(geometry) if geometry is not None else []
-            if len(shapes) != 1 or shapes[0].tag not in ('box', 'cylinder', 'sphere'):
+            if _urdf_primitive(part) is None:
                 raise ModelFileError('robot %r, link %r: a %s of %s cannot be built here: only box, cylinder and sphere'
                                      % (robot.get('name'), link.get('name'), part.tag,
-                                        ', '.join('<%s>' % shape.tag for shape in shapes) or 'no geometry'))
+                                        ', '.join('<%s>' % shape.tag for shape in part.findall('geometry/*'))
+                                        or 'no geometry'))
         for origin in link.iter('origin'):
             _numbers(origin.get('xyz', '0 0 0'), 3, 'link %r origin xyz' % link.get('name'))
             _numbers(origin.get('rpy', '0 0 0'), 3, 'link %r origin rpy' % link.get('name'))
     static = any((element.text or '').strip().lower() in TRUE for element in robot.findall('gazebo/static'))
     return UrdfModel(robot.get('name', ''), static, links)
+
+
+def _urdf_primitive(part):
+    """The one <box>, <cylinder> or <sphere> of a URDF <visual> or <collision>, else None."""
+    geometry = part.find('geometry')
+    shapes = list(geometry) if geometry is not None else []
+    return shapes[0] if len(shapes) == 1 and shapes[0].tag in URDF_SIZES else None
+
+
+def urdf_collisions(text):
+    """{link name: [Shape of each <collision>, its pose in the link's frame]} of a
+    URDF's text; None if a collision is not a box, cylinder or sphere (a mesh)."""
+    collisions = {}
+    for link in _root(text, 'URDF').findall('link'):
+        for collision in link.findall('collision'):
+            shape = _urdf_primitive(collision)
+            if shape is None:
+                return None
+            where = 'link %r collision' % link.get('name')
+            size = [value for name in URDF_SIZES[shape.tag]
+                    for value in _numbers(shape.get(name), 3 if name == 'size' else 1, where + ' ' + name)]
+            origin = collision.find('origin')
+            origin = origin if origin is not None else {}
+            pose = (tuple(_numbers(origin.get('xyz', '0 0 0'), 3, where + ' origin xyz')),
+                    from_rpy(*_numbers(origin.get('rpy', '0 0 0'), 3, where + ' origin rpy')))
+            collisions.setdefault(link.get('name'), []).append(Shape(shape.tag, tuple(size), pose, None))
+    return collisions
 
 
 def link_shapes(model):

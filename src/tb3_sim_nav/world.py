@@ -11,10 +11,10 @@ nothing else changes what collides with what. A robot's lidar casts its rays
 with every bit but its own, so it sees the ground, obstacles and the other
 robots, never itself.
 
-Rays meet the still part of the world (the ground and every static object
-built of boxes, cylinders and spheres) in numpy (rays.py), all lidars of a
-step at once; only the rays that pass near a moving body (another robot, a
-spawned model) or a static model of a URDF are cast by pybullet.
+Rays meet the ground and every body of boxes, cylinders and spheres (the
+obstacles, the robots where their links are now, spawned models) in numpy
+(rays.py), all lidars of a step at once; only the rays that pass near a body
+with another shape (a robot's mesh) are cast by pybullet.
 """
 import math
 import pkgutil
@@ -26,7 +26,7 @@ from pybullet_utils.bullet_client import BulletClient
 from .bodies import ObjectBody, RobotBody, int32, link_frame, load_urdf
 from .frames import IDENTITY, compose, inverse, planar, yaw_of
 from .model_files import Shape
-from .rays import StaticScene
+from .rays import Scene
 
 GRAVITY = 9.81           # m/s^2
 GROUND_FRICTION = 1.0    # rubber tyre on a hard floor
@@ -39,9 +39,11 @@ SHAPE_COLOR = (0.75, 0.75, 0.72, 1.0)  # a shape with no colour of its own
 ROBOT_GROUPS = tuple(1 << bit for bit in range(2, 32))  # the collision groups robots get, one each
 MAX_ROBOTS = len(ROBOT_GROUPS)
 #: Still shapes within a lidar's reach past which pybullet casts all its rays
-#: instead of numpy: numpy tests every beam against every shape near it, and a
+#: instead of numpy: numpy tested every beam against every shape near it, and a
 #: map world's walls (670 boxes in rbx1's test map) made a scan 25 times
-#: turtlebot3_world's (15 shapes); pybullet's broadphase does not pay per shape.
+#: turtlebot3_world's (15 shapes). Since rays.py culls by heading, numpy casts
+#: that map (270-280 within reach) at 0.70-0.83 ms a scan, pybullet at 1.55-1.88
+#: (2026-11-24): the bound could rise, changing such ranges by Bullet's margins.
 MAX_STILL_SHAPES = 40
 
 
@@ -83,7 +85,8 @@ class World(object):
             self.objects[name] = self._build(name, [(shape, False), (shape, True)],
                                              planar(*obstacle.position, yaw=obstacle.yaw), static=True)
             self.objects[name].index = index + 1
-        self._still = None  # the rays' StaticScene, made anew when a static object comes, goes or moves
+        self._still = None  # the rays' Scene of the still world, made anew when a static object comes, goes or moves
+        self._moving = None  # the bodies not in it, and the rays' Scene of their shapes in their links' frames
 
     # --- objects: obstacles and spawned models ---------------------------------
     def _shape(self, shape, visual):
@@ -145,7 +148,7 @@ class World(object):
             raise ValueError('model %s: pybullet could not build its URDF' % name)
         # pybullet puts a base at its centre of mass: the model frame is the root link's.
         inertia = self.p.getDynamicsInfo(body, -1)
-        placed = ObjectBody(self, name, body, static, (tuple(inertia[3]), tuple(inertia[4])))
+        placed = ObjectBody(self, name, body, static, (tuple(inertia[3]), tuple(inertia[4])), urdf_text=text)
         placed.teleport(pose)
         return self._place(placed)
 
@@ -270,46 +273,65 @@ class World(object):
         return rgba, depth
 
     def _still_scene(self):
-        """The rays' StaticScene: every shape of the static objects built of shapes."""
+        """The rays' Scene of the still world: every shape of the static objects built of shapes."""
         if self._still is None:
-            self._still = StaticScene([(kind, size, compose(body.base_pose(), pose))
-                                       for body in self.objects.values() if body.static and body.shapes
-                                       for kind, size, pose in body.shapes])
+            self._still = Scene([(kind, size, compose(body.base_pose(), pose))
+                                 for body in self.objects.values() if body.static and body.shapes
+                                 for kind, size, pose in body.shapes])
         return self._still
+
+    def _moving_scene(self):
+        """(scene, shaped, others) of the bodies not in the still Scene: `shaped`, those
+        of boxes, cylinders and spheres, whose shapes `scene` holds in their links'
+        frames, each owned by its body's index in `shaped`; `others`, the bodies that
+        pybullet must meet (a mesh). Made anew when a body comes or goes."""
+        bodies = [body for body in self.robots + list(self.objects.values()) if not (body.static and body.shapes)]
+        if self._moving is None or self._moving[0] != bodies:
+            shaped = [body for body in bodies if body.collisions is not None]
+            scene = Scene([(kind, size, pose) for body in shaped for _, kind, size, pose in body.collisions],
+                          [owner for owner, body in enumerate(shaped) for _ in body.collisions])
+            self._moving = (bodies, scene, shaped, [body for body in bodies if body.collisions is None])
+        return self._moving[1:]
 
     def cast(self, origins, directions, length, ignore):
         """Distance (L x N, m) along each of N rays from each of L origins (L x 3)
         in the unit `directions` (L x N x 3) to the first surface within `length`,
         inf where none; origin l's rays pass through the robot body ignore[l].
 
-        The still world is met in numpy (rays.py), all rays at once; pybullet
-        casts only the rays that pass within the bounding sphere of a body
-        that moves or is no union of shapes, each origin's together.
+        The ground and every body of boxes, cylinders and spheres are met in
+        numpy (rays.py), all rays at once, the moving ones where their links
+        are now; pybullet casts only the rays that pass within the bounding
+        sphere of a body with another shape (a mesh), each origin's together.
         """
         origins, directions = np.asarray(origins, dtype=float), np.asarray(directions, dtype=float)
-        scene = self._still_scene()
-        crowded = scene.reachable(origins, length) > MAX_STILL_SHAPES
+        still = self._still_scene()
+        crowded = still.reachable(origins, length) > MAX_STILL_SHAPES
+        local, shaped, others = self._moving_scene()
         distances = np.full(directions.shape[:2], math.inf)
         if not crowded.all():
-            distances[~crowded] = scene.cast(origins[~crowded], directions[~crowded], length)
-        others = [body for body in self.robots + list(self.objects.values()) if not (body.static and body.shapes)]
+            frames = [frame for body in shaped for frame in body.collision_frames()]
+            scene = still + local.placed([position for position, _ in frames], [turn for _, turn in frames])
+            owners = np.array([shaped.index(body) if body in shaped else -2 for body in ignore])  # -2: nobody's
+            distances[~crowded] = scene.cast(origins[~crowded], directions[~crowded], length, owners[~crowded])
         # pybullet then tests the others only: the still shapes (group 2, with
-        # the ground) are met already, unless a static URDF is among the others.
-        still = STATIC_BODIES if not any(body.static for body in others) else 0
+        # the ground) are met already, unless a static body is among the others.
+        met = STATIC_BODIES if not any(body.static for body in others) else 0
         for index, (origin, own) in enumerate(zip(origins, ignore)):
             reach = np.zeros(directions.shape[1])  # how far each ray must go to pass the bodies it nears
-            if crowded[index]:  # every ray, to its full length, the still shapes too
-                reach[:], still = length, 0
-            for body in others:
-                if body is not own:
-                    reach = np.maximum(reach, _passing(origin, directions[index], length, body))
+            mask = 0xFFFFFFFF & ~(own.group if own is not None else 0)
+            if crowded[index]:  # every ray, to its full length, whatever it meets
+                reach[:] = length
+            else:
+                mask &= ~met
+                for body in others:
+                    if body is not own:
+                        reach = np.maximum(reach, _passing(origin, directions[index], length, body))
             near = reach > 0.0
             if near.any():
-                mask = int32(0xFFFFFFFF & ~(own.group if own is not None else 0) & ~still)
                 reach = reach[near]
                 ends = origin + directions[index, near] * reach[:, None]
                 hits = self.p.rayTestBatch(np.broadcast_to(origin, ends.shape), ends, numThreads=1,
-                                           collisionFilterMask=mask)
+                                           collisionFilterMask=int32(mask))
                 found = np.array([hit[2] if hit[0] >= 0 else math.inf for hit in hits]) * reach
                 distances[index, near] = np.minimum(distances[index, near], found)
         return distances

@@ -1,8 +1,10 @@
-"""rays.StaticScene against distances worked out by hand: boxes, cylinders, spheres and the ground. No pybullet.
+"""rays.Scene against distances worked out by hand: boxes, cylinders, spheres and the ground, a body's shapes placed
+at its links' frames, rays that pass through their owner's shapes; its culling against every ray tested against
+every shape. No pybullet.
 
-The lidar's ranges come from here for every still shape (world.World.cast),
+The lidar's ranges come from here for every box, cylinder and sphere (world.World.cast),
 so they must be the exact surfaces: pybullet's convex cast stopped up to 6 mm
-short of a cylinder, a bias this must not copy. test_sensors.py checks the
+short of a cylinder, a bias this must not copy. test_world_rays.py checks the
 same casts against pybullet's, where the two agree.
 """
 import math
@@ -11,7 +13,7 @@ import numpy as np
 import pytest
 
 from tb3_sim_nav.frames import from_rpy, planar, quaternion_multiply, rotate
-from tb3_sim_nav.rays import StaticScene
+from tb3_sim_nav.rays import Scene
 
 LENGTH = 3.5  # the LDS-01's range_max
 
@@ -19,7 +21,7 @@ LENGTH = 3.5  # the LDS-01's range_max
 def cast(shapes, origin, directions, length=LENGTH):
     directions = np.asarray(directions, dtype=float)
     directions = directions / np.linalg.norm(directions, axis=-1, keepdims=True)
-    return StaticScene(shapes).cast(np.array([origin], dtype=float), directions[None], length)[0]
+    return Scene(shapes).cast(np.array([origin], dtype=float), directions[None], length)[0]
 
 
 def horizontal(angles):
@@ -117,13 +119,13 @@ def test_distances_do_not_change_when_shapes_and_rays_turn_together(seed):
     directions = rng.normal(size=(500, 3)) * (1.0, 1.0, 0.2)
     directions /= np.linalg.norm(directions, axis=1)[:, None]
     origin = centre + (0.0, 0.0, 0.3)
-    plain = StaticScene(shapes).cast(np.array([origin]), directions[None], LENGTH)[0]
+    plain = Scene(shapes).cast(np.array([origin]), directions[None], LENGTH)[0]
     turn = from_rpy(*rng.uniform(-math.pi, math.pi, 3))
 
     def turned(point):
         return centre + rotate(turn, np.subtract(point, centre))
-    scene = StaticScene([(kind, size, (turned(position), quaternion_multiply(turn, orientation)))
-                         for kind, size, (position, orientation) in shapes])
+    scene = Scene([(kind, size, (turned(position), quaternion_multiply(turn, orientation)))
+                   for kind, size, (position, orientation) in shapes])
     got = scene.cast(np.array([turned(origin)]), np.array([[rotate(turn, d) for d in directions]]), LENGTH)[0]
     assert np.isfinite(plain).sum() > 40
     assert np.array_equal(np.isfinite(got), np.isfinite(plain))
@@ -134,3 +136,72 @@ def test_distances_do_not_change_when_shapes_and_rays_turn_together(seed):
 def test_an_empty_scene_meets_only_the_ground():
     got = cast([], (0.0, 0.0, 0.5), [(1.0, 0.0, 0.0), (0.0, 0.6, -0.8)])
     assert got[0] == math.inf and got[1] == pytest.approx(0.625, abs=1e-12)
+
+
+def brute_force(shapes, origin, directions, length=LENGTH):
+    """The same casts with every ray tested against every shape (no culling), by rays' own exact tests."""
+    from tb3_sim_nav import rays
+    from tb3_sim_nav.frames import matrix
+    nearest = rays._ground(np.broadcast_to(origin, directions.shape), directions)
+    for kind, size, (position, orientation) in shapes:
+        turn = matrix(orientation)
+        start = np.broadcast_to(turn.T.dot(np.subtract(origin, position))[:, None], directions.T.shape)
+        test = {'box': rays._box, 'cylinder': rays._cylinder, 'sphere': rays._sphere}[kind]
+        half = np.broadcast_to(np.array(rays.halves(kind, size))[:, None], directions.T.shape)
+        nearest = np.minimum(nearest, test(start, turn.T.dot(directions.T), half))
+    return np.where(nearest <= length, nearest, np.inf)
+
+
+@pytest.mark.parametrize('seed', range(4))
+def test_culling_by_heading_keeps_every_ray_that_meets_a_shape(seed):
+    """Rays are tested only against the shapes whose shadow on the ground they
+    cross (a box's corners', a cylinder's or sphere's circle): every ray, of
+    every heading and slope, straight up and down too, from origins beside,
+    above and inside the shapes, finds what testing it against every shape finds."""
+    rng = np.random.default_rng(seed)
+    shapes = []
+    for _ in range(12):
+        kind = ('box', 'cylinder', 'sphere')[rng.integers(3)]
+        size = {'box': tuple(rng.uniform(0.05, 2.0, 3)), 'cylinder': tuple(rng.uniform(0.05, 1.0, 2)),
+                'sphere': (rng.uniform(0.05, 0.5),)}[kind]
+        shapes.append((kind, size, (tuple(rng.uniform(-1.5, 1.5, 2)) + (rng.uniform(0.0, 1.0),),
+                                    from_rpy(*rng.uniform(-math.pi, math.pi, 3)))))
+    directions = rng.normal(size=(720, 3)) * (1.0, 1.0, rng.uniform(0.0, 2.0))
+    directions[:100] = horizontal(np.sort(rng.uniform(-math.pi, math.pi, 100)))  # a lidar's: sorted, wrapping
+    directions[100:104] = [(0.0, 0.0, 1.0), (0.0, 0.0, -1.0), (-0.0, 0.0, 1.0), (1e-12, 0.0, -1.0)]
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    scene = Scene(shapes)
+    origins = np.array([np.append(rng.uniform(-2.0, 2.0, 2), rng.uniform(0.0, 1.5)) for _ in range(5)]
+                       + [shapes[0][2][0], shapes[1][2][0] + np.array((0.0, 0.0, 3.0))])  # inside, above a shape
+    got = scene.cast(origins, np.broadcast_to(directions, (len(origins),) + directions.shape).copy(), LENGTH)
+    hits = 0
+    for origin, found in zip(origins, got):
+        expected = brute_force(shapes, origin, directions)
+        hit = np.isfinite(expected)
+        assert np.array_equal(np.isfinite(found), hit)
+        assert np.abs(found[hit] - expected[hit]).max() < 1e-9
+        hits += hit.sum()
+    assert hits > 2000
+
+
+def test_an_origins_rays_pass_through_its_owners_shapes_and_no_one_elses():
+    shapes = [('box', (0.2, 0.2, 0.2), planar(1.0, 0.0, 0.18)), ('sphere', (0.1,), planar(2.0, 0.0, 0.18))]
+    scene = Scene(shapes, owners=[3, 4])
+    origins, beams = np.array([(0.0, 0.0, 0.18)] * 3), np.array([[(1.0, 0.0, 0.0)]] * 3)
+    assert scene.cast(origins, beams, LENGTH, [3, 4, -5])[:, 0] == pytest.approx([1.9, 0.9, 0.9])
+
+
+def test_placed_shapes_are_where_their_frames_put_them():
+    """A body's shapes, each in its link's frame: a box 0.1 m ahead of a frame at
+    (1, 0, 0.2) turned 90 degrees (the box then 0.1 m to its left, along y) and a
+    sphere at the origin of a frame at (0, 2, 0.2)."""
+    local = Scene([('box', (0.2, 0.4, 0.2), ((0.1, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))),
+                   ('sphere', (0.1,), ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)))])
+    placed = local.placed([(1.0, 0.0, 0.2), (0.0, 2.0, 0.2)], [planar(0, 0, yaw=math.pi / 2)[1], (0.0, 0.0, 0.0, 1.0)])
+    assert placed.centres == pytest.approx(np.array([(1.0, 0.1, 0.2), (0.0, 2.0, 0.2)]))
+    got = placed.cast(np.array([(0.0, 0.1, 0.2)]), np.array([[(1.0, 0.0, 0.0), (0.0, 1.0, 0.0)]]), LENGTH)[0]
+    # The box turned: 0.4 m along x (0.8 to 1.2), 0.2 m along y; the sphere's near side at y = 1.9.
+    assert got == pytest.approx([0.8, 1.8], abs=1e-9)
+    both = Scene([('cylinder', (0.1, 0.2), planar(3.0, 0.1, 0.2))]) + placed
+    assert both.cast(np.array([(0.0, 0.1, 0.2)]), np.array([[(1.0, 0.0, 0.0)]]), LENGTH)[0, 0] == pytest.approx(0.8)
+    assert both.cast(np.array([(5.0, 0.1, 0.2)]), np.array([[(-1.0, 0.0, 0.0)]]), LENGTH)[0, 0] == pytest.approx(1.9)

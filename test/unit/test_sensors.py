@@ -1,4 +1,5 @@
-"""Lidar and IMU on a real pybullet world (DIRECT): ranges, REP 117 limits, noise, rates; the world's rays against pybullet's."""
+"""Lidar and IMU on a real pybullet world (DIRECT): ranges, REP 117 limits, noise, rates. test_world_rays.py
+checks the world's rays against pybullet's."""
 import math
 
 import numpy as np
@@ -231,69 +232,3 @@ def test_imu_without_noise_parameters_is_noiseless(make_world):
     got = readings(robot, Imu(robot), 0.5)
     rates = np.array([reading.angular_velocity for reading in got])
     assert np.std(rates, axis=0).max() < 1e-5
-
-
-# --- ray casting ---------------------------------------------------------------------
-
-def every_ray_cast(robot, origin, directions, length):
-    """What World.cast must give: pybullet's own answer for every ray, `robot` transparent to them."""
-    from tb3_sim_nav.bodies import int32
-    ends = origin + directions * length
-    hits = robot.p.rayTestBatch(np.broadcast_to(origin, ends.shape), ends, numThreads=1,
-                                collisionFilterMask=int32(0xFFFFFFFF & ~robot.group))
-    return np.array([hit[2] * length if hit[0] >= 0 else math.inf for hit in hits])
-
-
-@pytest.mark.parametrize('seed', range(5))
-def test_the_worlds_rays_meet_what_pybullets_meet(world_factory, worlds_folder, burger_urdf, seed):
-    """Numpy for the still shapes and the ground, pybullet near the moving bodies:
-    what pybullet finds casting every ray, but where Bullet's convex cast of a
-    cylinder, which carries a margin, stops short of its surface (up to 6 mm at
-    a grazing angle, measured here) or grazes a cylinder the exact ray passes
-    within 1 mm of (1 ray in 100 here; the lidar's noise is 10 mm); 82-87 %
-    of the hits agree to 0.01 mm."""
-    from tb3_sim_nav.frames import planar
-    from tb3_sim_nav.model_files import Shape
-    from tb3_sim_nav.robot_model import load_model
-    from tb3_sim_nav.world_file import load_world
-    # Where tb3_world.launch spawns it, beside a pillar of its own, another
-    # robot, a tilted static box and a ball that moves.
-    robot = world_factory(STEP, 0.0, (-2.0, -0.5, 0.0, 0.0),
-                          load_world('turtlebot3_world', str(worlds_folder)).obstacles + [pillar(-1.7, -0.5)])
-    world = robot.world
-    other = world.add_robot(load_model(str(burger_urdf)).urdf_text, planar(-2.0, 0.3, 0.0, 1.0), 'other')
-    tilted = ((-1.6, 0.5, 0.2), (0.2, 0.1, 0.3, 0.927))
-    world.add_object('tilted', [(Shape('box', (0.3, 0.2, 0.2), ((0.0, 0.0, 0.0), (0, 0, 0, 1)), None), False)],
-                     (tilted[0], tuple(np.divide(tilted[1], np.linalg.norm(tilted[1])))), static=True)
-    world.add_object('ball', [(Shape('sphere', (0.1,), ((0.0, 0.0, 0.0), (0, 0, 0, 1)), None), False)],
-                     planar(-1.5, -0.9, 0.3), static=False)
-    rng = np.random.default_rng(seed)
-    hits, close, agree, rays = 0, 0, 0, 0
-    for _ in range(20):
-        # Origins in and far around the world, some inside obstacles, some
-        # below ground; rays of 0.1 to 4 m, some downwards, some along an axis.
-        origin = np.append(rng.uniform(-3.0, 3.0, 2), rng.uniform(-0.05, 0.4))
-        directions = rng.normal(size=(100, 3)) * (1.0, 1.0, rng.uniform(0.0, 0.3))
-        directions[:10, 1:] = 0.0
-        directions /= np.linalg.norm(directions, axis=1)[:, None]
-        length = rng.uniform(0.1, 4.0)
-        expected = every_ray_cast(robot, origin, directions, length)
-        got = world.cast([origin], directions[None], length, [robot])[0]
-        hits += np.isfinite(expected).sum()
-        rays += len(expected)
-        same = (got == expected) | (np.abs(got - expected) < 0.007)
-        agree += same.sum()
-        close += (np.isfinite(expected) & (np.abs(np.nan_to_num(got - expected)) < 1e-5)).sum()
-    assert hits > 300
-    assert agree >= 0.98 * rays
-    assert close >= 0.75 * hits
-    assert other.radius > 0.1
-
-
-def test_rays_in_a_world_of_still_shapes_are_not_cast_by_pybullet(make_world, monkeypatch):
-    import pybullet
-    robot = make_world(ROOM)
-    monkeypatch.setattr(pybullet, 'rayTestBatch', lambda *args, **kwargs: pytest.fail('cast'))
-    directions = np.array([[[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.6, -0.8]]])
-    distances = robot.world.cast([(SCAN_X, 0.0, 0.2)], directions, 3.5, [robot])[0]
-    assert distances == pytest.approx([FRONT, RIGHT, 0.25])
