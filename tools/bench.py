@@ -113,7 +113,7 @@ def house_spots(count, clearance=0.5, spacing=1.0):
     from tb3_sim_nav.world_file import load_world
     from tb3_sim_nav.world_map import in_plane, signed_distance
     walls = in_plane(load_world('turtlebot3_house', os.path.join(ROOT, 'worlds')).obstacles, 0.1)
-    taken = [(-7.0, -1.0), (-7.0, 1.0), (-5.0, 1.0)]  # multi_tb3.launch's defaults (first, second, third)
+    taken = [(-7.0, -1.0), (7.0, -1.0), (0.5, 3.0)]  # multi_tb3.launch's defaults (first, second, third)
     xs, ys = np.meshgrid(np.arange(-7.5, 7.6, spacing), np.arange(-4.5, 4.6, spacing))
     grid = np.column_stack((xs.ravel(), ys.ravel()))
     free = grid[signed_distance(walls, grid) > clearance]
