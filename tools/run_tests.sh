@@ -94,7 +94,8 @@ part 1 test_master_restart "$pytest test/system/test_master_restart.py"
 # Mapping and navigation: the SLAM, amcl and move_base keep a core busy (most run as fast as possible).
 part 2 test_explore "$pytest test/system/test_explore.py"
 part 2 test_navigation "$pytest test/system/test_navigation.py"
-part 2 test_slam "$pytest test/system/test_slam.py"
+# test_slam's loop at factor 1 waits on the clock for 88 s of its 130 (0.7 of a core on average).
+part 1 test_slam "$pytest test/system/test_slam.py"
 part 2 test_emanual "$pytest test/system/test_emanual.py"
 part 2 test_multi_robot_maps "$pytest test/system/test_multi_robot_maps.py"
 # Every other system-test file, whole.
