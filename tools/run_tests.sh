@@ -44,26 +44,34 @@ lint() {
 export -f lint
 
 # The plan (tb3_harness/parts.py starts, whenever slots are free, the first
-# part in this order that fits): the parts that run alone first, while the
-# machine is empty; the rostests, the longest part; those that keep a core
-# busy, which so run one after another beside the rostests; then the rest,
-# longest first, so that the last to end is a short one. doc/testing.md has
-# what each took.
+# part in this order that fits): the part that runs alone first, while the
+# machine is empty; then Ctrl+C's; the rostests, the longest part of one
+# slot; those that keep a core busy, the longest first, which so run one
+# after another beside the rostests and the parts of one slot; then the
+# rest, longest first, so that the last to end is a short one. Run so, 23:22
+# of make test became about 20 minutes (doc/testing.md has what each took).
 #
-# Alone: what times wall seconds that a busy machine stretches (Ctrl+C must end
-# the simulator within 2 s; sim time's pace in a stall against the pace before).
-part 3 test_ctrl_c "$pytest test/system/test_ctrl_c.py"
+# Alone: sim time's pace during a stall is compared with its pace before.
 part 3 test_stalled_reader "$pytest test/system/test_stalled_reader.py"
+# Ctrl+C must end the simulator within 2 s: it did in 0.42-0.90 s with the
+# busiest part of one slot beside it (the tutorial through bash with rviz,
+# a core's worth), 0.42-0.84 s alone (2026-11-24).
+part 2 test_ctrl_c "$pytest test/system/test_ctrl_c.py"
 # The rostests (test/*.test) the ROS way, as the README shows, in make setup's
 # workspace: one at a time (CMakeLists.txt), each with a master of its own.
 # catkin_make run_tests exits 0 whatever the tests say; catkin_test_results
 # tells. SIGINT first on a time-out: rostest then stops every node it started.
 part 1 rostests "cd .ws && timeout --signal=INT --kill-after=60 3600 catkin_make run_tests &&
   catkin_test_results build/test_results"
-# A core's worth each: python's own tests, a core kept busy on purpose (at
-# factors 1 and 0), a Waffle Pi's camera rendered and shown in rviz, a catkin
-# workspace built from scratch, 120 s of sim time under random and hostile
-# commands as fast as possible.
+# A core's worth or more each: mapping and navigation (the SLAM, amcl and
+# move_base, most as fast as possible), python's own tests, a core kept busy
+# on purpose (at factors 1 and 0), a Waffle Pi's camera rendered and shown in
+# rviz, a catkin workspace built from scratch, 120 s of sim time under
+# random and hostile commands as fast as possible.
+part 2 test_explore "$pytest test/system/test_explore.py"
+part 2 test_multi_robot_maps "$pytest test/system/test_multi_robot_maps.py"
+part 2 test_navigation "$pytest test/system/test_navigation.py"
+part 2 test_emanual "$pytest test/system/test_emanual.py"
 [ -n "$integration_only" ] || part 2 unit "$pytest test/unit"
 part 2 test_calibration.busy_core "$pytest test/system/test_calibration.py -k busy_core"
 part 2 test_readme_walkthrough.camera "$pytest test/system/test_readme_walkthrough.py -k camera"
@@ -78,26 +86,22 @@ part 2 test_own_workspace "$pytest test/system/test_own_workspace.py"
 # whatever the others do not name, so that a new test always runs.
 # Both `make demo`s write demo_output/: one after the other, in one share.
 part 1 demos "$pytest test/system/test_readme_walkthrough.py test/system/test_calibration.py -k make_demo"
-part 1 test_readme_walkthrough.tutorial "$pytest test/system/test_readme_walkthrough.py -k tutorial_command"
-part 1 test_teleop "$pytest test/system/test_teleop.py"
-part 1 test_speed_agreement.nav_square "$pytest test/system/test_speed_agreement.py -k nav_square"
-part 1 test_speed_agreement.odom_out_and_back "$pytest test/system/test_speed_agreement.py -k odom_out_and_back"
-part 1 test_speed_agreement "$pytest test/system/test_speed_agreement.py -k 'not nav_square and not odom_out_and_back'"
-part 1 test_readme_walkthrough \
-  "$pytest test/system/test_readme_walkthrough.py -k 'not make_demo and not tutorial_command and not camera'"
-part 1 test_two_hosts "$pytest test/system/test_two_hosts.py"
-part 1 test_models "$pytest test/system/test_models.py"
-part 1 test_known_worlds "$pytest test/system/test_known_worlds.py"
-part 1 test_calibration "$pytest test/system/test_calibration.py -k 'not make_demo and not busy_core'"
-part 1 test_bad_startup "$pytest test/system/test_bad_startup.py"
-part 1 test_master_restart "$pytest test/system/test_master_restart.py"
-# Mapping and navigation: the SLAM, amcl and move_base keep a core busy (most run as fast as possible).
-part 2 test_explore "$pytest test/system/test_explore.py"
-part 2 test_navigation "$pytest test/system/test_navigation.py"
 # test_slam's loop at factor 1 waits on the clock for 88 s of its 130 (0.7 of a core on average).
 part 1 test_slam "$pytest test/system/test_slam.py"
-part 2 test_emanual "$pytest test/system/test_emanual.py"
-part 2 test_multi_robot_maps "$pytest test/system/test_multi_robot_maps.py"
+part 1 test_rbx1_nav "$pytest test/system/test_rbx1_nav.py"
+part 1 test_readme_walkthrough.tutorial "$pytest test/system/test_readme_walkthrough.py -k tutorial_command"
+part 1 test_speed_agreement.nav_square "$pytest test/system/test_speed_agreement.py -k nav_square"
+part 1 test_teleop "$pytest test/system/test_teleop.py"
+part 1 test_speed_agreement.odom_out_and_back "$pytest test/system/test_speed_agreement.py -k odom_out_and_back"
+part 1 test_two_hosts "$pytest test/system/test_two_hosts.py"
+part 1 test_readme_walkthrough \
+  "$pytest test/system/test_readme_walkthrough.py -k 'not make_demo and not tutorial_command and not camera'"
+part 1 test_models "$pytest test/system/test_models.py"
+part 1 test_speed_agreement "$pytest test/system/test_speed_agreement.py -k 'not nav_square and not odom_out_and_back'"
+part 1 test_known_worlds "$pytest test/system/test_known_worlds.py"
+part 1 test_calibration "$pytest test/system/test_calibration.py -k 'not make_demo and not busy_core'"
+part 1 test_master_restart "$pytest test/system/test_master_restart.py"
+part 1 test_bad_startup "$pytest test/system/test_bad_startup.py"
 # Every other system-test file, whole.
 for test_file in test/system/test_*.py; do
   name=$(basename "$test_file" .py)
