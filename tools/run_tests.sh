@@ -49,7 +49,7 @@ export -f lint
 # slot; those that keep a core busy, the longest first, which so run one
 # after another beside the rostests and the parts of one slot; then the
 # rest, longest first, so that the last to end is a short one. Run so, 23:22
-# of make test became about 20 minutes (doc/testing.md has what each took).
+# of make test became 20:52 from a fresh clone (doc/testing.md has what each took).
 #
 # Alone: sim time's pace during a stall is compared with its pace before.
 part 3 test_stalled_reader "$pytest test/system/test_stalled_reader.py"
