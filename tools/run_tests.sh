@@ -44,7 +44,7 @@ lint() {
 export -f lint
 
 # The plan (tb3_harness/parts.py starts, whenever slots are free, the first
-# part in this order that fits): the part that runs alone first, while the
+# part in this order that fits): the parts that run alone first, while the
 # machine is empty; then Ctrl+C's; the rostests, the longest part of one
 # slot; those that keep a core busy, the longest first, which so run one
 # after another beside the rostests and the parts of one slot; then the
@@ -53,6 +53,11 @@ export -f lint
 #
 # Alone: sim time's pace during a stall is compared with its pace before.
 part 3 test_stalled_reader "$pytest test/system/test_stalled_reader.py"
+# amcl is no cmd_vel publisher, so lockstep does not wait for it: on a busy
+# machine its estimate lags, and the four goals' true distances (the test's
+# 5 cm) with it. Beside the rostests and demos goal 4 ended 5.4 cm from the
+# truth with amcl 5.1 cm off; alone 1.0-2.9 cm (2026-11-24).
+part 3 test_navigation "$pytest test/system/test_navigation.py"
 # Ctrl+C must end the simulator within 2 s: it did in 0.42-0.90 s with the
 # busiest part of one slot beside it (the tutorial through bash with rviz,
 # a core's worth), 0.42-0.84 s alone (2026-11-24).
@@ -70,7 +75,6 @@ part 1 rostests "cd .ws && timeout --signal=INT --kill-after=60 3600 catkin_make
 # random and hostile commands as fast as possible.
 part 2 test_explore "$pytest test/system/test_explore.py"
 part 2 test_multi_robot_maps "$pytest test/system/test_multi_robot_maps.py"
-part 2 test_navigation "$pytest test/system/test_navigation.py"
 part 2 test_emanual "$pytest test/system/test_emanual.py"
 [ -n "$integration_only" ] || part 2 unit "$pytest test/unit"
 part 2 test_calibration.busy_core "$pytest test/system/test_calibration.py -k busy_core"
