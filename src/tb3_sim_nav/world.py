@@ -61,6 +61,7 @@ class World(object):
 
     def __init__(self, time_step=1.0 / 200, obstacles=(), gui=False, cameras=False):
         self.gui = gui
+        self.robots = []
         self.p = p = BulletClient(pybullet.GUI if gui else pybullet.DIRECT)
         if p._client < 0:
             raise RuntimeError('pybullet could not open a %s connection' % ('GUI' if gui else 'DIRECT'))
@@ -75,7 +76,6 @@ class World(object):
                                      visualFramePosition=[0, 0, -0.0005], rgbaColor=GROUND_COLOR)
         self.plane = p.createMultiBody(0, p.createCollisionShape(p.GEOM_PLANE), ground)
         p.changeDynamics(self.plane, -1, lateralFriction=1.0)
-        self.robots = []
         self.objects = {}  # name -> ObjectBody: the world file's obstacles, then what was spawned
         for index, obstacle in enumerate(obstacles):
             name = obstacle.name or '%s_%d' % (obstacle.kind, index + 1)
@@ -254,7 +254,7 @@ class World(object):
     def set_gravity(self, gravity):
         self.gravity = tuple(gravity)
         self.p.setGravity(*self.gravity)
-        for body in getattr(self, 'robots', ()):  # a sleeping robot would not feel it
+        for body in self.robots:  # a sleeping robot would not feel it
             body.wake()
 
     def set_time_step(self, seconds):
