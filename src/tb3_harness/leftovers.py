@@ -2,8 +2,7 @@
 
 A run (make demo, bench, soak, each part of make test) marks its
 environment with a tag of its own (TB3_RUN=<pid>.<time>); every process it
-starts inherits it, down to the nodes roslaunch and rostest start and the
-robot_state_publishers the simulator starts. When the run ends, any process
+starts inherits it, down to the nodes roslaunch and rostest start. When the run ends, any process
 still carrying the tag, other than the checker and its ancestors, was left
 behind: a bug (a node that survived Ctrl+C, an orphan whose roslaunch died),
 and the run fails after ending it.

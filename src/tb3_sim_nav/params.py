@@ -135,7 +135,7 @@ class Config(object):
     odom_frame: str = _p('odom', 'frame of odom and of its tf parent (a robot with a name gets it as a prefix: tb3_0/odom)', _frame_id)
     base_frame: str = _p('base_footprint', 'child frame of odom and its tf (prefixed as odom_frame)', _frame_id)
     world_frame: str = _p('world', "the world's frame: the simulator publishes tf from it to each robot's odom frame (the truth: the identity while odom is the true pose, the drift of encoder odometry otherwise) and draws the world's obstacles in it on world_markers; empty: neither (when a localization node publishes odom's parent)", _optional_frame_id)
-    robot_state_publisher: bool = _p(True, 'start a robot_state_publisher (with tf_prefix) for each robot with a name, and set its NAME/robot_description')
+    robot_state_publisher: bool = _p(True, 'publish what a robot_state_publisher with tf_prefix would for each robot with a name (its fixed joints on /tf_static, its wheels on /tf); false: only set NAME/robot_description, for nodes of your own')
     scan: bool = _p(True, 'publish the LDS-01 lidar on scan')
     scan_rate: float = _p(5.0, 'scan rate (sim time)', _positive, 'Hz')
     scan_samples: int = _p(360, 'beams per turn', _at_least(3))

@@ -1,4 +1,4 @@
-"""A robot model read from its URDF: drive geometry, limits, casters, cameras. The one source of truth.
+"""A robot model read from its URDF: drive geometry, limits, casters, cameras, joints. The one source of truth.
 
 The simulator knows a TurtleBot3 only through its URDF: the wheels' radius
 and separation from the wheel joints and links, the drive's limits from the
@@ -8,11 +8,13 @@ ball casters from their link names, and its cameras from the same
 ROBOTIS' Gazebo descriptions give (size, field of view, clip, rate, topics,
 frame).
 """
+import math
 import os
 import xml.etree.ElementTree as ElementTree
 from collections import namedtuple
 
 from .diff_drive import Limits
+from .frames import compose, from_rpy
 
 LEFT_WHEEL_JOINT = 'wheel_left_joint'
 RIGHT_WHEEL_JOINT = 'wheel_right_joint'
@@ -33,7 +35,35 @@ CameraSpec = namedtuple('CameraSpec', 'link name depth width height horizontal_f
                                       'image_topic info_topic depth_topic depth_info_topic points_topic cutoff')
 
 #: Everything the simulator takes from a robot's URDF (its text too; urdf_file is None for one spawned as text).
-RobotModel = namedtuple('RobotModel', 'urdf_file urdf_text name geometry limits casters cameras')
+RobotModel = namedtuple('RobotModel', 'urdf_file urdf_text name geometry limits casters cameras joints')
+
+#: Joint types whose child moves with the joint's position (robot_state_publisher reads it from joint_states).
+MOVING_JOINTS = ('revolute', 'continuous', 'prismatic')
+
+
+class Joint(namedtuple('Joint', 'name kind parent child origin axis')):
+    """A URDF <joint>: type, parent and child links, origin (a pose) and unit axis."""
+
+    @property
+    def moving(self):
+        return self.kind in MOVING_JOINTS
+
+    @property
+    def fixed(self):
+        """What robot_state_publisher (1.15) puts on /tf_static: every joint that does not
+        move, but a floating one (KDL cannot move a planar joint either: fixed too)."""
+        return not self.moving and self.kind != 'floating'
+
+    def pose(self, position=0.0):
+        """The child link's frame in the parent's at `position` (rad; m if prismatic):
+        the origin, then a turn or a shift along the axis, as KDL's segment gives it."""
+        if self.kind in ('revolute', 'continuous'):
+            sine = math.sin(0.5 * position)
+            turn = (self.axis[0] * sine, self.axis[1] * sine, self.axis[2] * sine, math.cos(0.5 * position))
+            return compose(self.origin, ((0.0, 0.0, 0.0), turn))
+        if self.kind == 'prismatic':
+            return compose(self.origin, (tuple(value * position for value in self.axis), (0.0, 0.0, 0.0, 1.0)))
+        return self.origin
 
 
 class ModelError(ValueError):
@@ -80,6 +110,23 @@ def urdf_text_for_pybullet(text):
         return _completed(ElementTree.fromstring(text))
     except ElementTree.ParseError as error:
         raise ModelError('the URDF is not valid XML: %s' % error)
+
+
+def _joints(robot):
+    """The robot's <joint> elements (not those a <transmission> names) with their
+    parent and child links; URDF's defaults: origin at the parent's, axis x."""
+    joints = []
+    for joint in robot.findall('joint'):
+        parent, child, origin, axis = (joint.find(tag) for tag in ('parent', 'child', 'origin', 'axis'))
+        if parent is None or child is None:
+            continue
+        xyz = _floats(origin.get('xyz', '0 0 0')) if origin is not None else [0.0] * 3
+        rpy = _floats(origin.get('rpy', '0 0 0')) if origin is not None else [0.0] * 3
+        direction = _floats(axis.get('xyz', '1 0 0')) if axis is not None else [1.0, 0.0, 0.0]
+        length = math.sqrt(sum(value * value for value in direction)) or 1.0
+        joints.append(Joint(joint.get('name'), joint.get('type'), parent.get('link'), child.get('link'),
+                            (tuple(xyz), from_rpy(*rpy)), tuple(value / length for value in direction)))
+    return tuple(joints)
 
 
 def _drive_geometry(robot, urdf_path):
@@ -207,7 +254,7 @@ def _model(robot, text, urdf_path, urdf_file):
                            if link.get('name', '').startswith(CASTER_PREFIX)))
     return RobotModel(urdf_file=urdf_file, urdf_text=text, name=robot.get('name', ''),
                       geometry=_drive_geometry(robot, urdf_path), limits=_limits(robot, urdf_path),
-                      casters=casters, cameras=_cameras(robot, urdf_path))
+                      casters=casters, cameras=_cameras(robot, urdf_path), joints=_joints(robot))
 
 
 #: The TurtleBot3 family, as TURTLEBOT3_MODEL names it.

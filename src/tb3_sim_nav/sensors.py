@@ -22,6 +22,7 @@ import numpy as np
 
 from .frames import matrix
 from .odometry import WheelOdometry, WorldOdometry
+from .robot_model import LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT
 
 ImuReading = namedtuple('ImuReading', 'orientation angular_velocity linear_acceleration')
 #: The true pose and twist of base_footprint (pose in the world, twist in its own frame), and odom's.
@@ -90,13 +91,18 @@ class Odometry(Sensor):
 
 
 class WheelEncoders(Sensor):
-    """The wheels' joint states."""
+    """The wheels' joint states; `joints` are the wheels' URDF joints, left then right."""
 
     name, rate_parameter = 'joint_states', 'joint_states_rate'
 
+    def __init__(self, body, rate, joints=()):
+        super(WheelEncoders, self).__init__(body, rate)
+        self.joints = tuple(joints)
+
     @classmethod
     def build(cls, body, model, config, rng):
-        return [cls(body, config.joint_states_rate)]
+        named = dict((joint.name, joint) for joint in model.joints)
+        return [cls(body, config.joint_states_rate, [named[name] for name in (LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT)])]
 
     def read(self, now_ns):
         return WheelReading(*self.body.wheel_states())

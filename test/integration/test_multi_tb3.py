@@ -11,7 +11,10 @@ facing -0.8 rad. In turn:
 3. tb3_0's lidar sees tb3_1: the beam towards tb3_1's lidar housing (a
    cylinder of radius 0.055 m, 0.015 m ahead of its base_scan) reads the
    distance to it, about 0.95 m, where the wall beyond is 2.2 m away;
-4. each robot driven alone moves alone (the others within 1 mm);
+4. each robot driven alone moves alone (the others within 1 mm); then every
+   link of tb3_1 (wheels turned) is where Debian's robot_state_publisher,
+   run on tb3_1's description and joint states with tf_prefix `reference`,
+   puts it: the simulator publishes each named robot's tree itself;
 5. /gazebo/reset_world puts each robot back at its own spawn pose;
 6. tb3_0 and tb3_1, turned to face each other and driven at 0.2 m/s for 6 s
    (1.2 m each, with 1 m between them), stop against each other: their
@@ -23,14 +26,18 @@ facing -0.8 rad. In turn:
    the tyres can hold.)
 """
 import math
+import signal
+import subprocess
 import unittest
+import xml.etree.ElementTree as ElementTree
 
+import roslib.packages
 import rospy
 import rostest
 import tf2_ros
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import LaserScan
+from sensor_msgs.msg import JointState, LaserScan
 from std_srvs.srv import Empty
 
 from tb3_test_utils import (GroundTruth, Repeater, init_test_node, report, turn_to, wait_for,
@@ -66,12 +73,22 @@ class MultiRobot(unittest.TestCase):
         cls.buffer = tf2_ros.Buffer()
         cls.listener = tf2_ros.TransformListener(cls.buffer)
         cls.errors = {}
-        for phase in ('ready', 'tf', 'scan', 'alone', 'reset', 'collision'):
-            try:
-                getattr(cls, '_phase_' + phase)()
-            except AssertionError as error:
-                cls.errors[phase] = str(error)
-                break
+        cls.reference = None
+        try:
+            for phase in ('ready', 'tf', 'scan', 'alone', 'tree', 'reset', 'collision'):
+                try:
+                    getattr(cls, '_phase_' + phase)()
+                except AssertionError as error:
+                    cls.errors[phase] = str(error)
+                    break
+        finally:
+            if cls.reference is not None:
+                cls.reference.send_signal(signal.SIGINT)
+                try:
+                    cls.reference.wait(10.0)
+                except subprocess.TimeoutExpired:
+                    cls.reference.kill()
+                    cls.reference.wait()
         for publisher in cls.cmd_vel.values():
             publisher.publish(Twist())
 
@@ -94,6 +111,13 @@ class MultiRobot(unittest.TestCase):
         cls.spawned = dict((name, wait_for_simulator(cls.truth[name], cls.cmd_vel[name])) for name in ROBOTS)
         cls.odom = dict((name, rospy.wait_for_message('/%s/odom' % name, Odometry, wall_budget(2.0)))
                         for name in ROBOTS)
+        # Debian's robot_state_publisher on tb3_1's description (set by now) and
+        # joint states, under another prefix: the tree the simulator publishes
+        # must be its tree (phase tree).
+        cls.reference = subprocess.Popen(
+            [roslib.packages.find_node('robot_state_publisher', 'robot_state_publisher')[0],
+             '__name:=reference_state_publisher', '__ns:=/tb3_1', '_tf_prefix:=reference'],
+            stdin=subprocess.DEVNULL)
         cls.ran_ready = True
 
     @classmethod
@@ -131,6 +155,28 @@ class MultiRobot(unittest.TestCase):
                                      for name in ROBOTS)
             report('driven_alone_' + driven, **cls.moves[driven])
         cls.ran_alone = True
+
+    @classmethod
+    def _phase_tree(cls):
+        """tb3_1's links in its base_footprint, from the simulator's tf and from the reference's,
+        at the stamp of one joint_states message (both stamp the wheels with it)."""
+        urdf = ElementTree.fromstring(rospy.get_param('/tb3_1/robot_description'))
+        links = sorted(joint.find('child').get('link') for joint in urdf.findall('joint'))
+        states = rospy.wait_for_message('/tb3_1/joint_states', JointState, wall_budget(2.0))
+        cls.wheel_angles = dict(zip(states.name, states.position))
+        cls.tree = {}
+        for link in links:
+            pair = []
+            for prefix in ('tb3_1', 'reference'):
+                try:
+                    pair.append(cls.buffer.lookup_transform('%s/base_footprint' % prefix, '%s/%s' % (prefix, link),
+                                                            states.header.stamp,
+                                                            rospy.Duration(wall_budget(5.0))).transform)
+                except tf2_ros.TransformException as error:
+                    raise AssertionError('no tf %s/base_footprint -> %s/%s at %s: %s'
+                                         % (prefix, prefix, link, states.header.stamp.to_sec(), error))
+            cls.tree[link] = pair
+        cls.ran_tree = True
 
     @classmethod
     def _phase_reset(cls):
@@ -212,6 +258,20 @@ class MultiRobot(unittest.TestCase):
             for name, moved in moves.items():
                 if name != driven:
                     self.assertLess(moved, 0.001, '%s moved %.4f m while %s was driven' % (name, moved, driven))
+
+    def test_each_link_is_where_robot_state_publisher_puts_it(self):
+        self.need('tree')
+        turned = [name for name, angle in self.wheel_angles.items() if abs(angle) > 0.5]
+        self.assertEqual(len(turned), 2, 'the wheels did not turn: %s' % self.wheel_angles)
+        self.assertGreaterEqual(len(self.tree), 6)
+        for link, (ours, reference) in self.tree.items():
+            for field in ('translation', 'rotation'):
+                a, b = getattr(ours, field), getattr(reference, field)
+                keys = 'xyz' if field == 'translation' else 'xyzw'
+                sign = -1.0 if field == 'rotation' and sum(getattr(a, k) * getattr(b, k) for k in keys) < 0 else 1.0
+                for key in keys:
+                    self.assertAlmostEqual(getattr(a, key), sign * getattr(b, key), delta=1e-6,
+                                           msg='%s %s.%s: %s against %s' % (link, field, key, a, b))
 
     def test_reset_world_puts_each_robot_back_at_its_own_spawn_pose(self):
         self.need('reset')

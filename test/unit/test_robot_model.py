@@ -184,3 +184,70 @@ def test_models_by_name_are_urdfs_of_the_folder_and_paths_are_paths(tmp_path):
 def test_an_unknown_model_is_refused_naming_the_three(tmp_path):
     with pytest.raises(ModelError, match="model 'wafle': unknown TurtleBot3 model: the models are burger, waffle, waffle_pi"):
         model_urdf('wafle', '/pkg/urdf')
+
+
+# --- joints: what robot_state_publisher makes of them ----------------------
+
+def _kdl_pose(joint, position):
+    """The joint's child in its parent at `position` as KDL computes it for
+    robot_state_publisher (kdl_parser: the joint turns or slides about its
+    axis, given in the parent frame through the origin; the segment's tip is
+    the origin)."""
+    import PyKDL
+    (x, y, z), (qx, qy, qz, qw) = joint.origin
+    origin = PyKDL.Frame(PyKDL.Rotation.Quaternion(qx, qy, qz, qw), PyKDL.Vector(x, y, z))
+    axis = origin.M * PyKDL.Vector(*joint.axis)
+    kind = {'revolute': PyKDL.Joint.RotAxis, 'continuous': PyKDL.Joint.RotAxis,
+            'prismatic': PyKDL.Joint.TransAxis}
+    kdl_joint = (PyKDL.Joint(joint.name, origin.p, axis, kind[joint.kind]) if joint.kind in kind
+                 else PyKDL.Joint(joint.name))
+    frame = PyKDL.Segment(joint.child, kdl_joint, origin).pose(position)
+    return (frame.p[0], frame.p[1], frame.p[2]), frame.M.GetQuaternion()
+
+
+def _same_pose(a, b):
+    (position_a, rotation_a), (position_b, rotation_b) = a, b
+    sign = 1.0 if sum(u * v for u, v in zip(rotation_a, rotation_b)) >= 0.0 else -1.0
+    return (max(abs(u - v) for u, v in zip(position_a, position_b)) < 1e-12
+            and max(abs(u - sign * v) for u, v in zip(rotation_a, rotation_b)) < 1e-12)
+
+
+@pytest.mark.parametrize('model', ['burger', 'waffle', 'waffle_pi'])
+def test_every_joint_of_the_shipped_urdfs_is_where_kdl_puts_it(model):
+    import random
+    import os
+    urdfs = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), 'urdf')
+    joints = load_model(model_urdf(model, urdfs)).joints
+    assert {joint.name for joint in joints if joint.moving} == {'wheel_left_joint', 'wheel_right_joint'}
+    assert len([joint for joint in joints if joint.fixed]) >= 4  # base, imu, scan, casters (and cameras)
+    rng = random.Random(7)
+    for joint in joints:
+        for position in [0.0, 1.0, -2.5] + [rng.uniform(-20.0, 20.0) for _ in range(5)]:
+            assert _same_pose(joint.pose(position), _kdl_pose(joint, position)), (joint.name, position)
+
+
+def test_joint_kinds_defaults_and_transmissions(tmp_path):
+    """URDF's defaults (no origin: the parent's frame; no axis: x), a slanted
+    axis, a prismatic joint, a floating one left out as robot_state_publisher
+    leaves it, and a <transmission>'s <joint> not taken for a joint."""
+    body = two_wheels() + '<drive_limits max_linear_speed="0.22" max_angular_speed="2.84"/>' + (
+        '<link name="arm"/><link name="slide"/><link name="free"/><link name="flat"/>'
+        '<joint name="arm_joint" type="revolute"><parent link="base"/><child link="arm"/>'
+        '<origin xyz="0.1 0 0.2" rpy="0.3 -0.2 1.1"/><axis xyz="1 1 0"/></joint>'
+        '<joint name="slide_joint" type="prismatic"><parent link="arm"/><child link="slide"/>'
+        '<axis xyz="0 0 2"/></joint>'
+        '<joint name="free_joint" type="floating"><parent link="base"/><child link="free"/></joint>'
+        '<joint name="flat_joint" type="fixed"><parent link="base"/><child link="flat"/></joint>'
+        '<transmission name="t"><joint name="arm_joint"><hardwareInterface>x</hardwareInterface></joint>'
+        '</transmission>')
+    joints = {joint.name: joint for joint in load_model(str(write(tmp_path, body))).joints}
+    assert sorted(joints) == ['arm_joint', 'flat_joint', 'free_joint', 'slide_joint', 'wheel_left_joint',
+                              'wheel_right_joint']
+    assert [name for name, joint in sorted(joints.items()) if joint.fixed] == ['flat_joint']
+    assert not joints['free_joint'].fixed and not joints['free_joint'].moving
+    assert joints['flat_joint'].pose(5.0) == ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+    assert joints['slide_joint'].axis == (0.0, 0.0, 1.0)
+    assert _same_pose(joints['slide_joint'].pose(0.25), ((0.0, 0.0, 0.25), (0.0, 0.0, 0.0, 1.0)))
+    for position in (0.0, 0.7, -3.0):
+        assert _same_pose(joints['arm_joint'].pose(position), _kdl_pose(joints['arm_joint'], position))
+        assert _same_pose(joints['slide_joint'].pose(position), _kdl_pose(joints['slide_joint'], position))

@@ -1,4 +1,4 @@
-"""The robots' ROS side: a RobotIO per robot, their robot_state_publishers, what lockstep
+"""The robots' ROS side: a RobotIO per robot, their descriptions, what lockstep
 follows of them, and publishing what their sensors have due.
 """
 import threading
@@ -32,13 +32,13 @@ class Fleet(object):
         io = self.robots[robot.name] = RobotIO(robot, self.sim.config, self.publishers, self._throttle,
                                                self._command_received if self.lockstep else None)
         for sensor in io.sensors:
-            if self.world_links and sensor.transforms:
+            if self.world_links and sensor.odom_frame:
                 self.world_links.parents.add(sensor.odom_frame)
             for publisher in sensor.lockstep_readers if self.lockstep else ():
                 self.lockstep.follow_readers(publisher)
         if self.lockstep:
             self.lockstep.follow(io.cmd_vel)
-        self.descriptions.start(robot)
+        self.descriptions.start(robot, rospy.Time(*divmod(self.sim.now_ns, 1000000000)))
 
     def spawn(self, name, model, pose, model_name):
         """A robot spawned while running (in the step loop): it gets what a launched one has."""
@@ -86,5 +86,5 @@ class Fleet(object):
             io.publish(stamp, readings.get(id(io)))
             transforms.extend(io.transforms)
         if transforms and self.world_links:
-            transforms.extend(self.world_links.links([io for io in due if io.transforms], stamp))
+            transforms.extend(self.world_links.links([io for io in due if io.odom_frame], stamp))
         return due, transforms

@@ -9,8 +9,7 @@ says why; nothing is changed then.
 
 Every change to the world runs in the step loop's thread, between steps
 (loop.Requests): pybullet is not to be called from two threads, and a
-spawned robot's robot_state_publisher must be started from the thread that
-lives as long as the node. It is handed what it serves from, not the node:
+spawned robot's topics join the step loop's publishing. It is handed what it serves from, not the node:
 the simulation, the step loop's requests, the fleet of robot interfaces,
 the world's markers and the pacer.
 """

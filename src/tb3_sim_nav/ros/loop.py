@@ -1,9 +1,8 @@
 """What other threads hand the step loop, and the world drawn for rviz.
 
 pybullet is not to be called from two threads, and a spawned robot's
-robot_state_publisher must be started from the thread that lives as long
-as the node: every change to the world runs in the step loop, between
-steps (Requests.run).
+topics join the step loop's publishing: every change to the world runs in
+the step loop, between steps (Requests.run).
 """
 import queue
 import threading

@@ -42,8 +42,9 @@ RESTORED_PARAMETERS = ('/use_sim_time', '/robot_description')  # set again on a 
 class SimulatorNode(object):
     """Steps the simulation in sim time and publishes what Gazebo's TurtleBot3s do."""
 
-    def __init__(self, simulation, descriptions, life):
-        """`life`: the node's lifecycle.Life; the step loop runs until it says stop."""
+    def __init__(self, simulation, parameters, life):
+        """`parameters`: a dict of the parameters it sets, for the master watch; `life`: the
+        node's lifecycle.Life; the step loop runs until it says stop."""
         self.sim = simulation
         config = simulation.config
         self.life = life
@@ -64,6 +65,7 @@ class SimulatorNode(object):
             poll = max(LOCKSTEP_POLL, LOCKSTEP_POLL_SHARE / config.physics_rate / factor) if factor else LOCKSTEP_POLL
             self.lockstep = Lockstep(config.lockstep_timeout, poll, self._throttle, WARN_PERIOD)
         world_links = WorldLinks(config.world_frame, ()) if config.world_frame else None
+        descriptions = Descriptions(parameters, self.publishers, config.robot_state_publisher)
         self.fleet = Fleet(simulation, self.publishers, self._throttle, descriptions, self.lockstep, world_links)
         self.markers = Markers(simulation, self.publishers, config.world_frame or config.odom_frame)
         self.gazebo = GazeboInterface(simulation, self.publishers, self.requests, self.fleet, self.markers,
@@ -220,12 +222,10 @@ def main():
         # nodes that drive the robot whatever their priority).
         os.nice(10)
     restored = dict((name, rospy.get_param(name)) for name in RESTORED_PARAMETERS if rospy.has_param(name))
-    descriptions = Descriptions(restored, config.robot_state_publisher)
     try:
-        node = SimulatorNode(simulation, descriptions, life)
+        node = SimulatorNode(simulation, restored, life)
         MasterWatch(restored).start()
         node.run()
     finally:
         life.finish()  # the step loop has stopped: now rospy may close every connection
-        descriptions.stop_all()
         simulation.close()

@@ -36,6 +36,7 @@ class SensorIO(object):
         self.publishers = []
         self.lockstep_readers = ()  # publishers whose local readers that publish tf lockstep waits for
         self.transforms = ()        # what it adds to the step's one tf message, once published
+        self.odom_frame = None      # an odometry's frame, which the world links to (odom_parents.py)
 
     def advertise(self, publishers, topic, message_class):
         publisher = publishers.advertise(self.prefix + topic, message_class)
@@ -95,15 +96,26 @@ class OdomIO(SensorIO):
 
 
 class JointStatesIO(SensorIO):
+    """joint_states, and for a robot with a name (unless ~robot_state_publisher is
+    false) what robot_state_publisher would make of them: the wheels' links in
+    the step's tf message, stamped as joint_states (robot_state.py)."""
 
     def __init__(self, sensor, prefix, publishers, config):
         super(JointStatesIO, self).__init__(sensor, prefix)
         self.message = messages.joint_states()
         self.publisher = self.advertise(publishers, 'joint_states', JointState)
+        if prefix and config.robot_state_publisher:
+            self.transforms = tuple(messages.transform(prefix + joint.parent, prefix + joint.child)
+                                    for joint in sensor.joints)
+
+    def wanted(self):
+        return bool(self.transforms) or super(JointStatesIO, self).wanted()
 
     def publish(self, stamp, reading):
         messages.fill_joint_states(self.message, stamp, *reading)
         self.publisher.publish(self.message)
+        for transform, joint, position in zip(self.transforms, self.sensor.joints, reading.positions):
+            messages.fill_transform(transform, stamp, joint.pose(position))
 
 
 class ScanIO(SensorIO):
