@@ -1,4 +1,4 @@
-"""The lidars' cost with many Burgers in one world, core only, no ROS: bench.py's ten in turtlebot3_world or thirty in turtlebot3_house.
+"""The lidars' cost with many Burgers in one world, core only, no ROS: bench_sim.py's ten in turtlebot3_world or thirty in turtlebot3_house.
 
 Times Lidar.read_all of all their lidars (CPU, time.process_time) and keeps
 their noiseless ranges. With --before, a second source tree (its src folder,
@@ -18,16 +18,16 @@ import subprocess
 import sys
 import time
 
-from bench import SEVEN, house_spots
+from bench_sim import SEVEN, house_spots
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-#: (x, y, yaw) of multi_tb3.launch's three as bench.py's MULTI_WORLD places them, and as the launch does.
+#: (x, y, yaw) of multi_tb3.launch's three as bench_sim.py's MULTI_WORLD places them, and as the launch does.
 WORLD_THREE = [(-2.0, -0.5, 0.0), (-2.0, 0.5, 0.0), (-1.5, 1.6, -0.8)]
 HOUSE_THREE = [(-7.0, -1.0, 1.57), (7.0, -1.0, 1.57), (0.5, 3.0, 0.0)]
 
 
 def robots(house):
-    """(world, [(x, y, yaw) of each robot]) of bench.py's ten in turtlebot3_world or thirty in turtlebot3_house."""
+    """(world, [(x, y, yaw) of each robot]) of bench_sim.py's ten in turtlebot3_world or thirty in turtlebot3_house."""
     if house:
         return 'turtlebot3_house', HOUSE_THREE + [(x, y, 0.0) for x, y in house_spots(27)]
     return 'turtlebot3_world', WORLD_THREE + [(x, y, 0.0) for _, (x, y) in SEVEN]
@@ -84,7 +84,7 @@ def agreement(before, after):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument('--house', action='store_true', help="bench.py's thirty robots in turtlebot3_house")
+    parser.add_argument('--house', action='store_true', help="bench_sim.py's thirty robots in turtlebot3_house")
     parser.add_argument('--before', help='the src folder of the tree to compare with')
     parser.add_argument('--rounds', type=int, default=5)
     parser.add_argument('--casts', type=int, default=40, help='read_all calls a round')
