@@ -87,6 +87,12 @@ def shortest_paths(graph, shape, sources, limit=np.inf):
     return distances.reshape(shape), predecessors.reshape(shape)
 
 
+def distances_from(graph, shape, sources):
+    """The distances (H, W) of shortest_paths, without the predecessors."""
+    distances = dijkstra(graph, indices=np.atleast_1d(np.asarray(sources, dtype=np.intp)), min_only=True)
+    return distances.reshape(shape)
+
+
 def path_to(predecessors, target):
     """The flat indices of the cells from a source to `target` (both included),
     following `predecessors`; [target] alone if target is a source."""

@@ -31,7 +31,7 @@ import math
 import numpy as np
 
 from tb3_navigation.costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION
-from tb3_navigation.grid_graph import build, shortest_paths
+from tb3_navigation.grid_graph import build, distances_from
 
 CHUNK = 64  # trajectories whose footprints are checked together
 CLOSE = 1e4  # added to a trajectory nearer to an obstacle than obstacle_clearance: more than any other term
@@ -81,8 +81,9 @@ class TrajectoryScorer(object):
         scale_path = config.path_distance_bias * grid.resolution
         scale_goal = config.goal_distance_bias * grid.resolution
         cells = _plan_cells(costmap, dense)
-        return dict(path=_steps_from(costmap, blocked, cells), goal=_steps_from(costmap, blocked, cells[-1:]),
-                    front=_steps_from(costmap, blocked, _plan_cells(costmap, front)[-1:]),
+        graph = build(np.where(blocked, np.inf, 1.0), 4)  # one graph for the three: 8 % of move_base's time each
+        return dict(path=_steps_from(graph, blocked, cells), goal=_steps_from(graph, blocked, cells[-1:]),
+                    front=_steps_from(graph, blocked, _plan_cells(costmap, front)[-1:]),
                     scale_path=scale_path, scale_goal=scale_goal,
                     scale_alignment=0.0 if near_goal else scale_path)
 
@@ -189,13 +190,14 @@ def _plan_cells(costmap, points):
     return cells[:, 1] * grid.width + cells[:, 0]
 
 
-def _steps_from(costmap, blocked, sources):
-    """4-neighbour step counts (H, W) from the nearest source around blocked cells; blocked
-    cells count H * W (MapGrid's obstacleCosts), unreached ones H * W + 1."""
-    size = costmap.costs.size
+def _steps_from(graph, blocked, sources):
+    """4-neighbour step counts (H, W) over `graph` (unit steps, blocked cells not
+    enterable) from the nearest source around blocked cells; blocked cells count
+    H * W (MapGrid's obstacleCosts), unreached ones H * W + 1."""
+    size = blocked.size
     if not len(sources):
-        return np.full(costmap.costs.shape, size + 1.0)
-    distances, _ = shortest_paths(build(np.where(blocked, np.inf, 1.0), 4), blocked.shape, sources)
+        return np.full(blocked.shape, size + 1.0)
+    distances = distances_from(graph, blocked.shape, sources)
     distances[blocked] = np.where(np.isfinite(distances[blocked]), distances[blocked], size)
     return np.where(np.isfinite(distances), distances, size + 1.0)
 
