@@ -22,7 +22,7 @@ import statistics
 import sys
 import time
 
-import bench
+import bench_sim
 from tb3_harness import leftovers
 from tb3_harness.measure import machine, memory_mib, sim_pid
 from tb3_harness.processes import Process, RunError, say, start_master, wait_until
@@ -130,7 +130,7 @@ def main(argv=None):
         rospy.init_node('tb3_soak', anonymous=True, argv=[sys.argv[0]], disable_signals=True)
         checker = Checker()
         clock = checker  # its /clock subscriber tells sim time
-        sim = bench.start_sim('soak', log_dir, 0.0)
+        sim = bench_sim.start_sim('soak', log_dir, 0.0)
         wait_until(lambda: clock.clock is not None and clock.clock > 2.0, 60, '/clock')
         pid = sim_pid()
         warm = memory_mib(pid, 'VmRSS')
