@@ -37,6 +37,7 @@ ANGULAR_HALF_STEP = 0.05   # rad/s
 ZERO = (0.0,) * 6
 
 START_WITHIN = 30.0   # wall s for the teleop to show its keys (rospy start-up)
+KEY_REPEAT = 1.0 / 25.0  # wall s between typed keys: a held key's autorepeat (X's default rate, 25 a second)
 SIM_READY = 60.0      # wall s for the simulator's first ground truth
 PRINT_WITHIN = 5.0    # wall s for a key's target line to be printed
 REACH_WITHIN = 20.0   # wall s for cmd_vel to reach a target (0.1 s per half step)
@@ -84,7 +85,14 @@ class PtyProcess(harness.Process):
             return self._output.decode(errors='replace').replace('\r\n', '\n')
 
     def type(self, keys):
-        os.write(self.master, keys.encode())
+        """Keys one after another at a held key's autorepeat rate (KEY_REPEAT), as a
+        person types them: written all at once, the teleop's loop published one
+        message a key within a millisecond, and on a busy machine its publisher
+        (queue_size=10, as ROBOTIS') dropped some before rostopic echo saw them."""
+        for index, key in enumerate(keys):
+            if index:
+                time.sleep(KEY_REPEAT)
+            os.write(self.master, key.encode())
 
     def settings(self):
         return termios.tcgetattr(self.slave)

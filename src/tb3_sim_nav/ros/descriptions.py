@@ -32,7 +32,8 @@ class Descriptions(object):
 
     def __init__(self, parameters, publishers, static_tf=True):
         self.parameters = parameters
-        self._static = publishers.advertise('tf_static', TFMessage, latch=True) if static_tf else None
+        self._publishers = publishers if static_tf else None
+        self._static = None  # advertised with the first robot that has a name: the tutorial's has none
         self._fixed = {}  # robot name -> its fixed joints' transforms
 
     def start(self, robot, stamp):
@@ -43,9 +44,11 @@ class Descriptions(object):
         name = namespace + '/robot_description'
         rospy.set_param(name, robot.model.urdf_text)
         self.parameters[name] = robot.model.urdf_text
-        if self._static is None:
+        if self._publishers is None:
             rospy.loginfo('%s: robot_description set', namespace)
             return
+        if self._static is None:
+            self._static = self._publishers.advertise('tf_static', TFMessage, latch=True)
         prefix = robot.name + '/'
         fixed = []
         for joint in robot.model.joints:
