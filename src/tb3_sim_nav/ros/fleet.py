@@ -9,6 +9,7 @@ from ..frames import planar, yaw_of
 from ..sensors import read_all
 from ..simulation import ModelStateError
 from ..world_file import ROBOT_NAME
+from . import messages
 from .robot_io import RobotIO
 
 
@@ -38,7 +39,7 @@ class Fleet(object):
                 self.lockstep.follow_readers(publisher)
         if self.lockstep:
             self.lockstep.follow(io.cmd_vel)
-        self.descriptions.start(robot, rospy.Time(*divmod(self.sim.now_ns, 1000000000)))
+        self.descriptions.start(robot, messages.stamp_of(self.sim.now_ns))
 
     def spawn(self, name, model, pose, model_name):
         """A robot spawned while running (in the step loop): it gets what a launched one has."""

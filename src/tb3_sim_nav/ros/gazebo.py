@@ -28,6 +28,7 @@ from ..frames import compose, normalized
 from ..model_files import ModelFileError, check_urdf, link_shapes, parse_sdf
 from ..robot_model import ModelError, load_model_text
 from ..simulation import ModelStateError
+from . import messages
 
 #: What GetPhysicsProperties reports as ode_config: Gazebo's own defaults (pybullet uses none of them).
 ODE_DEFAULTS = dict(auto_disable_bodies=False, sor_pgs_precon_iters=0, sor_pgs_iters=50, sor_pgs_w=1.3,
@@ -121,7 +122,7 @@ class GazeboInterface(object):
             pose, linear, angular = self.sim.model_state(request.model_name, request.relative_entity_name)
             _fill_pose(response.pose, pose)
             _fill_twist(response.twist, linear, angular)
-            response.header.stamp = rospy.Time(*divmod(self.sim.now_ns, 1000000000))
+            response.header.stamp = messages.stamp_of(self.sim.now_ns)
             response.header.frame_id = request.relative_entity_name
             return 'GetModelState: got properties'
         return self._answer(response, work)

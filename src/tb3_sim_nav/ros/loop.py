@@ -66,7 +66,7 @@ class Markers(object):
     def changed(self, stamp=None):
         """Draw the world anew (in the step loop)."""
         self.publisher.publish(messages.world_markers(self.frame, self.sim.world.visual_shapes(),
-                                                      stamp or rospy.Time(*divmod(self.sim.now_ns, 1000000000))))
+                                                      stamp or messages.stamp_of(self.sim.now_ns)))
 
     def moving(self):
         return any(not body.static for body in self.sim.world.objects.values())

@@ -4,6 +4,7 @@ Each message is made once per robot and reused: a publication changes only
 its stamp and values.
 """
 import numpy as np
+import rospy
 from geometry_msgs.msg import TransformStamped
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import CameraInfo, Image, Imu, JointState, LaserScan, PointCloud2, PointField
@@ -14,6 +15,11 @@ from ..robot_model import LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT
 # Diagonal covariances of odom, as Gazebo's diff-drive plugin fills them:
 # x, y and yaw are known well; z, roll and pitch are not estimated at all.
 ODOM_COVARIANCE = (1e-5, 1e-5, 1e12, 1e12, 1e12, 1e-3)
+
+
+def stamp_of(now_ns):
+    """The ROS time of sim time `now_ns` (ns), exactly."""
+    return rospy.Time(*divmod(now_ns, 1000000000))
 
 
 def diagonal(values):

@@ -23,7 +23,7 @@ from ..pacing import Pacer
 from ..robot_model import ModelError, load_model, model_urdf
 from ..throttle import Throttle
 from ..world_file import RobotSpec, WorldError, load_world
-from . import rospy_internals
+from . import messages, rospy_internals
 from .descriptions import Descriptions
 from .fleet import Fleet
 from .gazebo import GazeboInterface
@@ -139,7 +139,7 @@ class SimulatorNode(object):
         now_ns = self.sim.now_ns
         # One stamp for the whole step, new each step: rospy sends the latched
         # /clock to a new subscriber from another thread, so it must not change.
-        stamp = rospy.Time(*divmod(now_ns, 1000000000))
+        stamp = messages.stamp_of(now_ns)
         published = self.publish_data(now_ns, stamp)
         self.gazebo.publish()
         self.publishers.flush()
