@@ -41,9 +41,20 @@ def tail(filename, lines=15):
         return '(no log)'
 
 
-def _die_with_parent():
-    # Runs in the child between fork and exec: should its parent be killed
-    # outright (SIGKILL at rostest's time limit), the kernel kills the child.
+def _as_from_a_terminal():
+    # Runs in the child between fork and exec. SIGINT and SIGQUIT back to their
+    # defaults, as a terminal's commands have them: whatever a script starts in
+    # the background (`make test &`, nohup, CI runners) inherits them ignored,
+    # and python then sets no KeyboardInterrupt handler (a `python -c 'while
+    # True: pass'` busy core outlived each SIGINT of make test's stops by 20 s).
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGQUIT, signal.SIG_DFL)
+
+
+def _as_from_a_terminal_dying_with_parent():
+    _as_from_a_terminal()
+    # Should the parent be killed outright (SIGKILL at rostest's time limit),
+    # the kernel kills the child.
     ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
 
 
@@ -59,7 +70,8 @@ class Process(object):
         with open(self.log, 'w') as log:
             self.popen = subprocess.Popen(self.argv, **dict(dict(
                 stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT, start_new_session=True,
-                preexec_fn=_die_with_parent if die_with_parent else None), **popen))
+                preexec_fn=_as_from_a_terminal_dying_with_parent if die_with_parent else _as_from_a_terminal),
+                **popen))
 
     @property
     def pid(self):
