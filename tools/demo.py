@@ -10,14 +10,14 @@ With --slam (`make demo DEMO_ARGS="--slam"`) it maps turtlebot3_world
 (tb3_harness/mapping.py): tb3_world.launch (profile realistic), tb3_slam.launch,
 a drive around the pillars, map_saver; the map in OUTPUT/map.yaml and .pgm, a
 table in OUTPUT/slam.txt and the map under the world's outline with the paths
-in OUTPUT/slam_map.png. As fast as possible unless --real-time-factor says.
+in OUTPUT/slam_map.png.
 
 With --nav (`make demo DEMO_ARGS="--nav"`) it navigates turtlebot3_world
 (tb3_harness/navigating.py): tb3_world.launch (profile realistic),
 tb3_navigation.launch on the shipped map, a 2D Pose Estimate at the spawn
 pose, four goals around and between the pillars; a table in OUTPUT/nav.txt
 and the map with the true path, the plans and amcl's particles in
-OUTPUT/nav_paths.png. As fast as possible unless --real-time-factor says.
+OUTPUT/nav_paths.png.
 
 With --explore (`make demo DEMO_ARGS="--explore"`) the robot maps
 turtlebot3_house alone (tb3_harness/exploring.py): tb3_house.launch (profile
@@ -26,14 +26,18 @@ map_saver; then tb3_house.launch afresh and tb3_navigation.launch on the saved
 map, a 2D Pose Estimate at the spawn pose and a goal in each of four rooms. A
 line per frontier and per goal as it goes; a table in OUTPUT/explore.txt; the
 map under the house's outline with the exploration's and the navigation's true
-paths in OUTPUT/explore.png. As fast as possible unless --real-time-factor says.
+paths in OUTPUT/explore.png.
+
+Every walkthrough runs as fast as possible unless --real-time-factor says
+(`--real-time-factor 1`: at real time): it is headless, and lockstep makes a
+script's path the same at every factor (the speed-agreement test checks it).
 
 Run inside `source setup.bash`. Starts one master on a free loopback port, then
 for each script does what the tutorial does: start the simulator fresh
-(`roslaunch tb3_sim_bringup tb3_empty_world.launch`), wait for odom ->
-base_footprint, `rosrun tb3_sim_nav SCRIPT`, stop the simulator (Ctrl+C to
-roslaunch). Meanwhile it records base_pose_ground_truth and odom, and at the end
-prints a table per script, writes it to OUTPUT/summary.txt and draws the paths
+(`roslaunch tb3_sim_bringup tb3_empty_world.launch real_time_factor:=F
+paused:=true`), `rosrun tb3_sim_nav SCRIPT`, unpause once the script has
+connected, stop the simulator (Ctrl+C to roslaunch). Meanwhile it records
+base_pose_ground_truth and odom, and at the end prints a table per script, writes it to OUTPUT/summary.txt and draws the paths
 to OUTPUT/demo_paths.png. Each process's output goes to OUTPUT/logs/.
 
 Exit status 0 if every script ran and exited 0; everything started here is
@@ -67,8 +71,9 @@ class Interrupted(BaseException):
 
 def parse_args(argv):
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--real-time-factor', type=float, metavar='F',
-                        help='launch arg real_time_factor (default 1.0; --slam: 0 = as fast as possible)')
+    parser.add_argument('--real-time-factor', type=float, default=0.0, metavar='F',
+                        help='launch arg real_time_factor (default 0 = as fast as possible: nothing is '
+                             'shown, and lockstep makes the paths the same at every factor)')
     parser.add_argument('--profile', metavar='NAME',
                         help='launch arg profile (passed only if given)')
     parser.add_argument('--model', choices=TURTLEBOT3_MODELS,
@@ -92,8 +97,6 @@ def parse_args(argv):
     if mapping_chapters and (args.scripts or args.profile not in (None, 'realistic')):
         parser.error('--slam, --nav and --explore run their own drives in profile realistic: no --scripts, '
                      'no other --profile')
-    if args.real_time_factor is None:
-        args.real_time_factor = 0.0 if mapping_chapters else 1.0
     if args.calibrate and (args.scripts or args.profile not in (None, 'realistic')):
         parser.error('--calibrate runs its own scripts in profile realistic: no --scripts, no other --profile')
     if not args.real_time_factor >= 0.0:
@@ -183,7 +186,9 @@ def main(argv=None):
                                                   launch='tb3_house.launch', map_file=explored.map_yaml,
                                                   goals=navigating.HOUSE_GOALS, spawn=navigating.HOUSE_SPAWN)
         for script, expected in scripts if not (args.calibrate or args.slam or args.nav or args.explore) else ():
-            result, error = run_script(script, expected, args, log_dir)
+            # Started paused, time starting once the script has connected: as fast as possible
+            # the simulator would otherwise run some 80 sim s while python starts the script.
+            result, error = run_script(script, expected, argparse.Namespace(paused_start=True, **vars(args)), log_dir)
             results.append(result)
             if error:
                 failures.append('%s: %s' % (script, error))
@@ -220,7 +225,9 @@ def main(argv=None):
     if results:
         header = ['tb3_sim_nav demo: the tutorial\'s scripts on the pybullet TurtleBot3 %s' % model,
                   'real_time_factor %g%s, total wall time %.1f s'
-                  % (args.real_time_factor, ', profile %s' % args.profile if args.profile else '', total), '']
+                  % (args.real_time_factor, ', profile %s' % args.profile if args.profile else '', total),
+                  'sim time: from the unpause to the script\'s exit (its python exit runs in sim time too:',
+                  'as fast as possible, tens of sim seconds)', '']
         lines = header
         for result in results:
             lines += report.table(result) + ['']

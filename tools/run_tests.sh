@@ -70,7 +70,7 @@ part 1 rostests "cd .ws && timeout --signal=INT --kill-after=60 3600 catkin_make
   catkin_test_results build/test_results"
 # A core's worth or more each: mapping and navigation (the SLAM, amcl and
 # move_base, most as fast as possible), python's own tests, a core kept busy
-# on purpose (at factors 1 and 0), a Waffle Pi's camera rendered and shown in
+# on purpose (at factors 1 and 0), both `make demo`s, a Waffle Pi's camera rendered and shown in
 # rviz, a catkin workspace built from scratch, 120 s of sim time under
 # random and hostile commands as fast as possible.
 part 2 test_explore "$pytest test/system/test_explore.py"
@@ -78,6 +78,8 @@ part 2 test_multi_robot_maps "$pytest test/system/test_multi_robot_maps.py"
 part 2 test_emanual "$pytest test/system/test_emanual.py"
 [ -n "$integration_only" ] || part 2 unit "$pytest test/unit"
 part 2 test_calibration.busy_core "$pytest test/system/test_calibration.py -k busy_core"
+# Both `make demo`s (as fast as possible) write demo_output/: one after the other, in one share.
+part 2 demos "$pytest test/system/test_readme_walkthrough.py test/system/test_calibration.py -k make_demo"
 part 2 test_readme_walkthrough.camera "$pytest test/system/test_readme_walkthrough.py -k camera"
 part 2 test_own_workspace "$pytest test/system/test_own_workspace.py"
 [ -n "$integration_only" ] ||
@@ -88,8 +90,6 @@ part 2 test_own_workspace "$pytest test/system/test_own_workspace.py"
 # pytest process talks to masters of its own (a process can be one rospy node
 # only). The long files run in shares (-k), the last share of each taking
 # whatever the others do not name, so that a new test always runs.
-# Both `make demo`s write demo_output/: one after the other, in one share.
-part 1 demos "$pytest test/system/test_readme_walkthrough.py test/system/test_calibration.py -k make_demo"
 # test_slam's loop at factor 1 waits on the clock for 88 s of its 130 (0.7 of a core on average).
 part 1 test_slam "$pytest test/system/test_slam.py"
 part 1 test_rbx1_nav "$pytest test/system/test_rbx1_nav.py"
