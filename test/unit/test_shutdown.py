@@ -65,3 +65,27 @@ def test_the_same_moment_deadlocks_a_handler_that_closes_the_connection():
     except subprocess.TimeoutExpired:
         return
     raise AssertionError('the handler that closes the connection did not deadlock: %s' % hung.stdout)
+
+
+HANGS_ON_ITS_WAY_OUT = textwrap.dedent('''
+    import os, signal, threading, time
+    from tb3_navigation.ros import lifecycle
+    lifecycle.STACKS_AFTER = 0.5
+    life = lifecycle.Life()
+    life.handle_signals()
+    def stuck_in_a_join():
+        threading.Event().wait(3.0)   # a thread the interpreter would wait for at exit
+    os.kill(os.getpid(), signal.SIGINT)
+    stuck_in_a_join()
+    print('ended: %s' % life.reason, flush=True)
+''')
+
+
+def test_a_node_still_running_after_its_end_was_asked_for_prints_where_its_threads_are():
+    """Once an end is asked for, a node that has not ended STACKS_AFTER s later prints every thread's stack."""
+    done = subprocess.run([sys.executable, '-c', HANGS_ON_ITS_WAY_OUT], stdout=subprocess.PIPE,
+                          stderr=subprocess.STDOUT, universal_newlines=True, timeout=30)
+    assert done.returncode == 0, done.stdout
+    assert 'Timeout (0:00:00.500000)!' in done.stdout, done.stdout
+    assert 'in stuck_in_a_join' in done.stdout, done.stdout
+    assert done.stdout.rstrip().endswith('ended: SIGINT received'), done.stdout

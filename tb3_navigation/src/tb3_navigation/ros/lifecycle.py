@@ -16,6 +16,7 @@ shutdown that rospy starts in another thread first asks the loop to stop and
 waits (briefly) until it has. A thread watches the parent: a node started by
 roslaunch or rostest ends when they are gone instead of living on as an orphan.
 """
+import faulthandler
 import os
 import signal
 import threading
@@ -27,6 +28,10 @@ PARENT_POLL = 0.5  # wall s between looks at the parent process
 LOOP_STOP_WAIT = 1.0  # wall s a shutdown from another thread waits for the node's loop to stop
 SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 LAUNCHERS = ('roslaunch', 'rostest')  # parents whose death ends the node
+# wall s after an end was asked for: a node still running then prints every
+# thread's stack to stderr (faulthandler: it works even if no python thread
+# can run), so that an end that hangs says where (roslaunch escalates at 15 s)
+STACKS_AFTER = 5.0
 
 
 def _command_line(pid):
@@ -58,10 +63,11 @@ class Life(object):
         self.reason = None
 
     def request_stop(self, reason):
-        """Safe in a signal handler: sets the flag, nothing else."""
+        """Safe in a signal handler: sets the flag (and arms the stacks' print, STACKS_AFTER)."""
         if not self._stop.is_set():
             self.reason = reason
             self._stop.set()
+            faulthandler.dump_traceback_later(STACKS_AFTER)
 
     @property
     def stopping(self):
