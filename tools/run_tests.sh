@@ -6,6 +6,7 @@
 # The parts run side by side as tb3_harness/parts.py schedules them, each in
 # the slots its load needs (3 slots on 2 cores; TB3_TEST_SLOTS=1 runs them one
 # at a time): 1 = mostly waits on real time, 2 = keeps a core busy, 3 = alone.
+# Once only parts of 1 slot are left, four of them run side by side.
 # Each part's output is shown whole when it ends; at the end come a table of
 # what each took and the lines that say why a part failed.
 #

@@ -59,6 +59,22 @@ def test_a_part_waiting_for_slots_lets_smaller_ones_pass_and_starts_when_enough_
         ('alone', 9, 10)]                        # alone at the end: everything else has passed it
 
 
+def test_once_only_parts_of_one_slot_are_left_one_more_runs_beside_them():
+    plan = [Part(1, 'rostests', ''), Part(2, 'busy', ''), Part(1, 'a', ''), Part(1, 'b', ''), Part(1, 'c', ''),
+            Part(1, 'd', ''), Part(1, 'e', '')]
+    durations = {'rostests': 10, 'busy': 4, 'a': 5, 'b': 5, 'c': 5, 'd': 5, 'e': 5}
+    assert _order(plan, 3, durations) == [
+        ('rostests', 0, 10), ('busy', 0, 4),     # 1 + 2 slots: full, and a part of 2 slots runs
+        ('a', 4, 9), ('b', 4, 9), ('c', 4, 9),   # busy has ended: four waiting parts side by side
+        ('d', 9, 14), ('e', 9, 14)]
+    # Not while a part of 2 slots still waits: it would wait behind every waiting part.
+    waits = [Part(1, 'a', ''), Part(1, 'b', ''), Part(1, 'c', ''), Part(2, 'busy', ''), Part(1, 'd', '')]
+    assert _order(waits, 3, dict(a=2, b=2, c=2, busy=1, d=1))[:4] == [
+        ('a', 0, 2), ('b', 0, 2), ('c', 0, 2), ('busy', 2, 3)]
+    # With one slot, still one part at a time.
+    assert [start for _, start, _ in _order(plan, 1, durations)] == [0, 10, 14, 19, 24, 29, 34]
+
+
 def test_why_keeps_the_lines_that_say_what_failed_once_each():
     output = '\n'.join([
         'collected 3 items', '....F', 'E       AssertionError: the robot moved 0.3 m',
