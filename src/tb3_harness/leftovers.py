@@ -20,20 +20,37 @@ TAG = 'TB3_RUN'
 GRACE = 5.0   # wall s a process has to end by itself once the run is over
 
 
-def _environ(pid):
+PF_KTHREAD = 0x00200000
+SETTLE = 1.0   # wall s a process caught in the middle of exec has to show its environment
+
+
+def _read(pid, name):
     try:
-        with open('/proc/%d/environ' % pid, 'rb') as stream:
-            return stream.read().split(b'\0')
+        with open('/proc/%d/%s' % (pid, name), 'rb') as stream:
+            return stream.read()
     except OSError:  # gone, or not ours to read
-        return ()
+        return b''
+
+
+def _in_exec(pid):
+    """True for a process between exec's new memory and its arguments: for that
+    moment (after the parent's fork returned) it shows neither environment nor
+    command line. Kernel threads and zombies show neither for good."""
+    if _read(pid, 'environ') or _read(pid, 'cmdline'):
+        return False
+    fields = _read(pid, 'stat').rsplit(b')', 1)[-1].split()
+    return len(fields) > 6 and fields[0] != b'Z' and not int(fields[6]) & PF_KTHREAD
+
+
+def _environ(pid):
+    deadline = time.monotonic() + SETTLE
+    while _in_exec(pid) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    return _read(pid, 'environ').split(b'\0')
 
 
 def _command_line(pid):
-    try:
-        with open('/proc/%d/cmdline' % pid, 'rb') as stream:
-            return stream.read().replace(b'\0', b' ').decode('utf-8', 'replace').strip()
-    except OSError:
-        return '?'
+    return _read(pid, 'cmdline').replace(b'\0', b' ').decode('utf-8', 'replace').strip() or '?'
 
 
 def _ancestors():
