@@ -76,9 +76,10 @@ def test_four_goals_around_the_pillars_succeed_within_the_tolerances(navigation)
     for goal in GOALS:
         outcome = navigation.go(*goal)
         least = clearance(outcome.path, obstacles, BURGER_FOOTPRINT)
-        print('MEASURED goal (%.2f, %.2f, %.2f): %s in %.1f s of sim time; truly %.3f m and %.3f rad off; '
-              'footprint at least %.3f m from the world' % (goal + (outcome.state, outcome.sim_seconds,
-                                                                   outcome.xy_error, outcome.yaw_error, least)))
+        print('MEASURED goal (%.2f, %.2f, %.2f): %s in %.1f s of sim time; truly %.3f m and %.3f rad off '
+              '(amcl %.3f m off); footprint at least %.3f m from the world'
+              % (goal + (outcome.state, outcome.sim_seconds, outcome.xy_error, outcome.yaw_error,
+                         outcome.amcl_error, least)))
         assert outcome.state == 'SUCCEEDED', (goal, outcome.state, outcome.text)
         assert outcome.xy_error <= XY_TOLERANCE and outcome.yaw_error <= YAW_TOLERANCE, outcome
         assert least >= CLEARANCE, (goal, least)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from tb3_navigation.controller import Command, DwaConfig, DwaController, dwa_config
+from tb3_navigation.controller import STALLED, Command, DwaConfig, DwaController, dwa_config
 from tb3_navigation.costmap import BURGER_FOOTPRINT, Costmap, CostmapConfig
 from tb3_navigation.planner import GlobalPlanner
 from tb3_navigation.pose2d import compose, normalize_angle
@@ -145,6 +145,47 @@ def test_at_the_goal_it_stops_then_turns_in_place_then_holds():
     assert (command.v, command.w) == (0.0, pytest.approx(0.5 - 0.32))  # brakes as hard as acc_lim_theta allows
     assert controller.is_goal_reached(facing, (0.0, 0.05), plan)
     assert not controller.is_goal_reached(facing, (0.0, 0.3), plan)  # not stopped yet
+
+
+def test_a_new_plan_neither_brakes_the_turn_to_the_goal_nor_restarts_the_approach():
+    # move_base hands DWA a new plan at 5 Hz, and every amcl update moves the goal a little in the
+    # odom frame. Forgetting the turn braked every other period (a quarter of the turning speed); taking
+    # the moved goal for a new one forgot the approach (the robot dithered 2-3 cm from the goal, until
+    # move_base's oscillation_timeout).
+    config = DwaConfig()
+    _, controller = open_field(config)
+    plan = straight_plan(0.5, 0.0)
+    plan[-1, 2] = 2.5  # most of half a turn to go, to the left
+    at_goal = (0.5 - 0.005, 0.0, 0.0)
+    assert controller.compute(at_goal, (0.0, 0.0), plan).w == pytest.approx(0.32)  # stopped: it turns
+    controller.reset()
+    assert controller.compute(at_goal, (0.0, 0.32), plan).w == pytest.approx(0.64)  # and turns on
+    # Passing 1.8 cm from the goal (within PASSED of the tolerance) and going away again ends the
+    # approach, though each period's goal is 5 mm away from the last one's.
+    _, controller = open_field(config)
+    for shift, x in enumerate((0.47, 0.49, 0.52)):
+        moved = straight_plan(0.5, 0.0) + (0.0, 0.005 * shift, 0.0)
+        controller.reset()
+        controller.compute((x, 0.02, 0.0), (0.11, 0.0), moved)
+    assert controller.is_position_reached((0.52, 0.02, 0.0), moved)  # 2.2 cm off
+
+
+def test_within_the_tolerance_an_approach_that_no_longer_comes_nearer_is_over():
+    # 4.8 cm from the goal (within xy_goal_tolerance, outside ARRIVAL and PASSED of it), stepping back
+    # and forth: after STALLED periods without coming 1 mm nearer the approach is over, as DWA stops.
+    _, controller = open_field()
+    plan = straight_plan(0.5, 0.0)
+    reached = []
+    for period in range(STALLED + 2):
+        pose = (0.452 + 0.0005 * (period % 2), 0.0, 0.0)
+        controller.compute(pose, (0.11, 0.0), plan)
+        reached.append(controller.is_position_reached(pose, plan))
+    assert reached.index(True) == STALLED and all(reached[STALLED:])
+    # Outside the tolerance it never is.
+    _, controller = open_field()
+    for period in range(3 * STALLED):
+        controller.compute((0.44, 0.0, 0.0), (0.11, 0.0), plan)
+    assert not controller.is_position_reached((0.44, 0.0, 0.0), plan)
 
 
 def test_refuses_what_would_collide_and_fails_when_boxed_in():

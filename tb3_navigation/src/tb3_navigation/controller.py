@@ -41,9 +41,14 @@ EPSILON = 1e-4  # m/s, rad/s: SimpleTrajectoryGenerator's slack on the velocity 
 #: error of 1-2 cm put the true pose outside. Here the approach ends within ARRIVAL of the distance
 #: tolerance, or within PASSED of it once the robot drives away from the goal again (it went by:
 #: turning back would only oscillate), and the goal counts as reached only once the turn in place
-#: has brought the heading within ARRIVAL of the yaw tolerance.
+#: has brought the heading within ARRIVAL of the yaw tolerance. Within the tolerance itself it also
+#: ends after STALLED periods (5 s, twice a half turn in place) without coming 1 mm nearer, where DWA
+#: would have stopped at once: near a wall the sampled trajectories left only a step forward and one
+#: back, and the Burger stood 4.8 cm from the goal until move_base's oscillation_timeout. (After 1 s
+#: it ended approaches still turning towards the goal, 5 cm off.)
 ARRIVAL = 0.3
 PASSED = 0.5
+STALLED = 50
 
 
 @dataclass(frozen=True)
@@ -143,27 +148,35 @@ class DwaController(object):
         self.costmap = costmap
         self.config = config
         self.scorer = TrajectoryScorer(costmap, config)
+        self._rotating = False  # turning to the goal's yaw (LatchedStopRotateController's rotating_to_goal_)
         self.reset()
 
     def reset(self):
-        """A new global plan: forget the goal latch and the oscillation flags (DWAPlannerROS::setPlan)."""
+        """A new global plan: forget the goal latch and the oscillation flags (DWAPlannerROS::setPlan).
+        A turn to the goal's yaw goes on (resetLatching keeps rotating_to_goal_): move_base plans anew
+        at 5 Hz, and forgetting it braked every other period, turning at a quarter of the speed."""
         self._latched = False
-        self._rotating = False
         self._flags = {}
         self._stationary = None
 
     def _same_goal(self, goal):
+        # In the local frame the goal moves with every correction of the localization (map -> odom):
+        # a goal that moved less than the tolerance is the same goal.
         return getattr(self, '_arrival_goal', None) is not None and \
-            math.hypot(goal[0] - self._arrival_goal[0], goal[1] - self._arrival_goal[1]) <= 1e-6
+            math.hypot(goal[0] - self._arrival_goal[0], goal[1] - self._arrival_goal[1]) <= self.config.xy_goal_tolerance
 
     def _arrive(self, pose, goal):
         """Whether the approach is over (once over, it stays so for this goal, across new plans): within
-        ARRIVAL of xy_goal_tolerance, or within PASSED of it and past the closest point of the way in."""
+        ARRIVAL of xy_goal_tolerance, within PASSED of it and past the closest point of the way in, or
+        within it and STALLED periods (calls) without coming nearer."""
         if not self._same_goal(goal):
             self._arrival_goal, self._arrived, self._closest = (goal[0], goal[1]), False, math.inf
+            self._rotating, self._stalled = False, 0
         distance = math.hypot(goal[0] - pose[0], goal[1] - pose[1])
         tolerance = self.config.xy_goal_tolerance
-        if distance <= ARRIVAL * tolerance or (distance <= PASSED * tolerance and distance > self._closest + 1e-3):
+        self._stalled = 0 if distance < self._closest - 1e-3 else self._stalled + 1
+        if distance <= ARRIVAL * tolerance or (distance <= PASSED * tolerance and distance > self._closest + 1e-3) \
+                or (distance <= tolerance and self._stalled >= STALLED):
             self._arrived = True
         self._closest = min(self._closest, distance)
         return self._arrived
