@@ -89,3 +89,25 @@ def test_a_node_still_running_after_its_end_was_asked_for_prints_where_its_threa
     assert 'Timeout (0:00:00.500000)!' in done.stdout, done.stdout
     assert 'in stuck_in_a_join' in done.stdout, done.stdout
     assert done.stdout.rstrip().endswith('ended: SIGINT received'), done.stdout
+
+
+def test_a_callback_does_not_run_once_an_end_was_asked_for_and_a_publish_to_a_closed_topic_ends_it_quietly():
+    import faulthandler
+    import rospy
+    from tb3_navigation.ros.lifecycle import Life
+    life, calls = Life(), []
+
+    def publishes(message):  # as amcl's scan callback when rospy closes its topics under it
+        calls.append(message)
+        if message == 'scan 2':
+            life.request_stop('SIGINT received')
+            faulthandler.cancel_dump_traceback_later()  # the stacks' print request_stop arms: not here
+        raise rospy.ROSException('publish() to a closed topic')
+    callback = life.callback(publishes)
+    try:
+        callback('scan 1')  # the node is not ending: the error is the callback's own, for rospy to log
+        raise AssertionError('a running node\'s callback error was swallowed')
+    except rospy.ROSException:
+        pass
+    assert callback('scan 2') is None  # the end came while it ran: quiet
+    assert callback('scan 3') is None and calls == ['scan 1', 'scan 2']  # once ending, it does not run

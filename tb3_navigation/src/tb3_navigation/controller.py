@@ -162,8 +162,8 @@ class DwaController(object):
     def _same_goal(self, goal):
         # In the local frame the goal moves with every correction of the localization (map -> odom):
         # a goal that moved less than the tolerance is the same goal.
-        return getattr(self, '_arrival_goal', None) is not None and \
-            math.hypot(goal[0] - self._arrival_goal[0], goal[1] - self._arrival_goal[1]) <= self.config.xy_goal_tolerance
+        last = getattr(self, '_arrival_goal', None)
+        return last is not None and math.hypot(goal[0] - last[0], goal[1] - last[1]) <= self.config.xy_goal_tolerance
 
     def _arrive(self, pose, goal):
         """Whether the approach is over (once over, it stays so for this goal, across new plans): within

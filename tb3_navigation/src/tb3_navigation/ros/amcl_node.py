@@ -45,7 +45,7 @@ def _pose_message(pose):
 
 class AmclNode(object):
 
-    def __init__(self):
+    def __init__(self, life):
         namespace = rospy.get_namespace()
         frames = dict((name, namespaced(frame, namespace)) for name, frame in FRAMES.items()
                       if not rospy.has_param('~' + name))
@@ -65,12 +65,12 @@ class AmclNode(object):
         rospy.Service('global_localization', Empty, self._on_global_localization)
         rospy.Service('request_nomotion_update', Empty, self._on_nomotion_update)
         rospy.Service('set_map', SetMap, self._on_set_map)
-        rospy.Subscriber('initialpose', PoseWithCovarianceStamped, self._on_initial_pose, queue_size=2)
+        rospy.Subscriber('initialpose', PoseWithCovarianceStamped, life.callback(self._on_initial_pose), queue_size=2)
         if self.use_map_topic:
-            rospy.Subscriber('map', OccupancyGrid, self._on_map, queue_size=1)
+            rospy.Subscriber('map', OccupancyGrid, life.callback(self._on_map), queue_size=1)
         else:
             threading.Thread(target=self._request_map, name='static_map', daemon=True).start()
-        rospy.Subscriber('scan', LaserScan, self._on_scan, queue_size=1)
+        rospy.Subscriber('scan', LaserScan, life.callback(self._on_scan), queue_size=1)
 
     # --- the map ------------------------------------------------------------------
     def _request_map(self):
@@ -206,5 +206,5 @@ class AmclNode(object):
 
 def main():
     life = lifecycle.init_node(NODE)
-    AmclNode()
+    AmclNode(life)
     life.spin()
