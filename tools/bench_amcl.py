@@ -22,7 +22,8 @@ sys.path.insert(0, os.path.join(ROOT, 'test', 'unit'))
 
 from drives import WORLD_LOOP, WORLD_LOOP_START, record_drive  # noqa: E402
 from test_localization import RVIZ_COVARIANCE, TIGHT, scan, world_grid  # noqa: E402
-from tb3_navigation.localization import Amcl, AmclConfig  # noqa: E402
+from tb3_navigation.amcl_config import AmclConfig  # noqa: E402
+from tb3_navigation.localization import Amcl  # noqa: E402
 
 
 def feed(amcl, drive):

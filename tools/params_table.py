@@ -13,7 +13,7 @@ from tb3_sim_nav.params import FROM_MODEL, FROM_PROFILE, PARAMETERS, PROFILES  #
 
 #: (node, parameter namespace, config class) of the navigation nodes, in doc/reference.md's order.
 NAVIGATION = [('tb3_slam', '', 'tb3_navigation.slam.SlamConfig'),
-              ('amcl', '', 'tb3_navigation.localization.AmclConfig'),
+              ('amcl', '', 'tb3_navigation.amcl_config.AmclConfig'),
               ('move_base', '', 'tb3_navigation.navigator.NavigatorConfig'),
               ('move_base', 'global_costmap/, local_costmap/', 'tb3_navigation.costmap.CostmapConfig'),
               ('move_base', 'NavfnROS/', 'tb3_navigation.planner.PlannerConfig'),

@@ -13,10 +13,10 @@ import pytest
 
 from conftest import REPO
 from drives import WORLD_LOOP, WORLD_LOOP_START, record_drive
+from tb3_navigation.amcl_config import AmclConfig
 from tb3_navigation.grid import Grid
 from tb3_navigation.map_files import load_map
-from tb3_navigation.localization import (RVIZ_COVARIANCE, Amcl, AmclConfig, covariance_3x3,
-                                         covariance_6x6)
+from tb3_navigation.localization import RVIZ_COVARIANCE, Amcl, covariance_3x3, covariance_6x6
 from tb3_navigation.pose2d import compose, normalize_angle
 from tb3_navigation.scan import Scan, endpoints
 from tb3_sim_nav import world_map

@@ -24,7 +24,8 @@ from nav_msgs.srv import GetMap, SetMap, SetMapResponse
 from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty, EmptyResponse
 
-from ..localization import Amcl, AmclConfig, covariance_3x3, covariance_6x6
+from ..amcl_config import AmclConfig
+from ..localization import Amcl, covariance_3x3, covariance_6x6
 from ..pose2d import quaternion_of_yaw, yaw_of_quaternion
 from ..scan import Scan
 from . import config, lifecycle
