@@ -1,10 +1,14 @@
-"""CPU of the localization core per filter update, and its particle counts, as a table.
+"""The localization core's accuracy, its CPU per filter update and its particle counts, as tables.
 
 Run inside `source setup.bash`. A benchmark, not a test: it records the loop
-around turtlebot3_world's pillars (profile realistic, as test_localization
-does; ~5 s) and feeds it to tb3_navigation.localization.Amcl, timing each
-update with time.process_time (CPU of this process: numpy here runs on one
-thread). No ROS master.
+around turtlebot3_world's pillars and a drive through test_navigation's four
+goals (profile realistic, as test_localization does; ~15 s each) and feeds
+them to tb3_navigation.localization.Amcl on the shipped map with TurtleBot3's
+parameters: the error of what a ROS user sees (tf map -> base_footprint, at
+every scan after the first quarter of the drive, and at the scans within
+5 cm of a goal) against the truth, the estimate as published and the cloud's
+mean (refine_estimate false); then CPU per update, timed with
+time.process_time (numpy here runs on one thread). No ROS master.
 
     python3 tools/bench_amcl.py [--seeds N]
 """
@@ -20,10 +24,13 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'test', 'unit'))
 
-from drives import WORLD_LOOP, WORLD_LOOP_START, record_drive  # noqa: E402
-from test_localization import RVIZ_COVARIANCE, TIGHT, scan, world_grid  # noqa: E402
+from drives import WORLD_GOALS, WORLD_GOALS_ROUTE, WORLD_LOOP, WORLD_LOOP_START, record_drive  # noqa: E402
+from test_localization import RVIZ_COVARIANCE, TIGHT, run, scan, travelled, world_grid  # noqa: E402
 from tb3_navigation.amcl_config import AmclConfig  # noqa: E402
 from tb3_navigation.localization import Amcl  # noqa: E402
+from tb3_navigation.map_files import load_map  # noqa: E402
+
+AT_GOAL = 0.05  # m: a scan taken this near a goal counts as one at the goal
 
 
 def feed(amcl, drive):
@@ -49,6 +56,34 @@ def feed(amcl, drive):
     return np.array(totals), np.array(parts), np.array(counts)
 
 
+def accuracy(drives, seeds):
+    """Rows of tf's error (cm: median, p95, worst) on each drive, as published and as the cloud's mean."""
+    shipped = load_map(os.path.join(ROOT, 'maps', 'turtlebot3_world.yaml'))
+    print('error of tf map -> base_footprint against the truth, cm (median / p95 / worst), %d seeds' % seeds)
+    print('%-52s %-20s %-20s' % ('drive', 'published', "the cloud's mean"))
+    for name, drive, goals in drives:
+        distance = travelled(drive)
+        late = distance > distance[-1] / 4.0
+        near = np.zeros(len(drive.times), dtype=bool)
+        for goal in goals:
+            near |= np.hypot(*(drive.truth[:, :2] - goal).T) < AT_GOAL
+        cells = {}
+        for refine in (True, False):
+            errors = []
+            for seed in range(seeds):
+                amcl = Amcl(AmclConfig(refine_estimate=refine), shipped.grid, shipped.values, seed=seed)
+                amcl.initialise(drive.truth[0], TIGHT)
+                errors.append(run(amcl, drive)[0])
+            errors = np.array(errors)
+            cells[refine] = [100 * np.percentile(errors[:, late], [50, 95, 100]),
+                             100 * np.percentile(errors[:, near], [50, 95, 100]) if near.any() else None]
+        for row, label in enumerate(('after its first quarter', 'at the goals (%d scans)' % near.sum())):
+            if cells[True][row] is not None:
+                print('%-52s %-20s %-20s' % ('%s, %s' % (name, label), '%.1f / %.1f / %.1f' % tuple(cells[True][row]),
+                                             '%.1f / %.1f / %.1f' % tuple(cells[False][row])))
+    print()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('--seeds', type=int, default=3, help='filter runs per row (default 3)')
@@ -57,6 +92,8 @@ def main():
           % (datetime.date.today(), platform.processor() or platform.machine(), os.cpu_count(),
              platform.python_version(), np.__version__))
     drive = record_drive('turtlebot3_world', WORLD_LOOP_START, WORLD_LOOP)
+    goals = record_drive('turtlebot3_world', WORLD_LOOP_START, WORLD_GOALS_ROUTE)
+    accuracy([('the loop (13.6 m)', drive, []), ("test_navigation's goals", goals, WORLD_GOALS)], seeds)
     world = world_grid('turtlebot3_world')
     print('loop: %d scans at 5 Hz, 13.6 m; 180 of 360 beams, those under 3.5 m (~163) weighed' % len(drive.times))
     print('ms of CPU per filter update; lik. = its likelihood part\n')

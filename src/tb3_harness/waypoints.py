@@ -14,6 +14,12 @@ WORLD_LOOP_START = (-2.0, -0.5, 0.0)
 WORLD_LOOP = [(-1.65, -0.5), (-1.65, 1.65), (0.55, 1.65), (1.65, 1.65), (1.65, -0.55), (1.65, -1.65),
               (-0.55, -1.65), (-1.65, -1.65), (-1.65, -0.5), (-2.0, -0.5)]
 
+#: test_navigation's four goals in its order from the same spawn pose, with the corners that keep the
+#: straight legs 0.4 m or more from the pillars: (-0.55, -0.55), (0.55, 0.55), (1.65, -0.55), (-0.55, 1.65).
+WORLD_GOALS = [(-0.55, -0.55), (0.55, 0.55), (1.65, -0.55), (-0.55, 1.65)]
+WORLD_GOALS_ROUTE = [(-0.55, -0.55), (0.55, -0.55), (0.55, 0.55), (1.65, 0.55), (1.65, -0.55), (1.65, 1.65),
+                     (-0.55, 1.65)]
+
 #: A tour of about 33 m through turtlebot3_house from tb3_house.launch's spawn pose
 #: (-3.0, 1.0): across the living room into the corridor, through the door at
 #: x = 2.3 into the east room, through the door at its north-west corner into

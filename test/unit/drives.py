@@ -19,7 +19,8 @@ from tb3_sim_nav.robot_model import load_model
 from tb3_sim_nav.simulation import build
 from tb3_sim_nav.world_file import load_world
 
-from tb3_harness.waypoints import (HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, Route,  # noqa: F401
+from tb3_harness.waypoints import (HOUSE_TOUR, HOUSE_TOUR_START, WORLD_GOALS, WORLD_GOALS_ROUTE, WORLD_LOOP,  # noqa: F401
+                                   WORLD_LOOP_START, Route,
                                    path_length)  # (for the tests)
 
 from conftest import REPO

@@ -361,5 +361,6 @@ def test_the_estimate_matched_to_the_map_is_nearer_the_truth_than_the_clouds_mea
     figures = {refine: np.percentile(values, [50, 95, 100]) for refine, values in errors.items()}
     print('MEASURED estimate error, cm (median, p95, worst): the cloud\'s mean %s, matched %s'
           % tuple(np.round(100 * figures[refine], 1).tolist() for refine in (False, True)))
-    assert figures[True][0] < 0.02 and figures[True][1] < 0.035 and figures[True][2] < 0.05
-    assert figures[True][0] < figures[False][0]
+    # Issue 28's bounds: p95 2 cm, worst 3 cm (measured 0.3, 0.8, 0.9 cm; the mean 3.6, 5.2, 5.7 cm).
+    assert figures[True][0] < 0.01 and figures[True][1] < 0.02 and figures[True][2] < 0.03
+    assert figures[True][1] < figures[False][1] / 3.0

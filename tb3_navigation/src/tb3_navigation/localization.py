@@ -30,16 +30,17 @@ Where this differs from amcl, and why:
   amcl_pose; the heaviest cluster's is there too.
 - The estimate's pose is the heaviest cluster's mean matched to the map by
   the update's scan (tb3_navigation.matcher: point-to-line Gauss-Newton to
-  lines fitted through the map's occupied cells, pulled towards the mean as
-  REFINE_PRIOR beams would), when the match keeps half the beams on walls
+  lines fitted through the map's occupied cells), pulled towards the mean as
+  much as the cluster's own spread says it knows (its covariance's inverse,
+  in beams of REFINE_SIGMA), when the match keeps half the beams on walls
   and moves the mean less than 0.1 m and 0.1 rad; else the mean itself
   (refine_estimate false: always). With TurtleBot3's flat beam model
   (sigma_hit 0.2, z_rand 0.5) the cloud is a few cm wide and its mean
-  wanders in it: on the loop round turtlebot3_world's pillars (2 seeds,
-  shipped map; after the first quarter) the mean was median 3.2, p95 4.9,
-  worst 5.4 cm off the truth, matched 1.6, 3.3, 3.7 cm (2026-11-24,
-  test_localization), and a robot stopping on the mean ended up to 6.5 cm
-  from its goal (tolerance 0.05 m). The particles are left as they are.
+  wanders in it: on the loop round turtlebot3_world's pillars (shipped map,
+  after its first quarter) the mean was median 3.5, p95 5.0, worst 5.7 cm
+  off the truth, and a robot stopping on it ended up to 6.5 cm from its
+  goal (tolerance 0.05 m). Matched, 0.3, 0.8, 0.9 cm (doc/design.md). The
+  particles are left as they are.
 """
 import math
 from collections import namedtuple
@@ -56,9 +57,13 @@ from tb3_navigation.scan import endpoints
 #: rviz's 2D Pose Estimate and amcl's initial_cov_*: 0.5 m and 15 degrees of standard deviation.
 RVIZ_COVARIANCE = np.diag([0.25, 0.25, (math.pi / 12.0) ** 2])
 
-REFINE_SIGMA = 0.05      # m: the walls' field of the refinement (gmapping's sigma on TurtleBot3)
+#: m: the walls' field of the refinement (gmapping's sigma on TurtleBot3), and a beam's standard deviation
+#: in it when the cluster's spread is weighed against the beams. A fixed pull of 20 beams towards the mean
+#: kept 40 % of the mean's error (p95 3.3 cm on the loop); the spread's pull keeps what the walls leave
+#: open (along a corridor) and little else.
+REFINE_SIGMA = 0.05
 REFINE_ITERATIONS = 5    # Gauss-Newton steps
-REFINE_PRIOR = 20.0      # beams' worth of pull towards the cluster's mean
+REFINE_FLOOR = 1e-6      # m^2, rad^2 added to the cluster's covariance: a collapsed cluster pulls hard, finitely
 REFINE_LIMIT = (0.1, 0.1)  # m, rad: a match moving the mean further is not taken
 REFINE_SHARE = 0.5       # of the beams that must score on walls
 
@@ -228,16 +233,18 @@ class Amcl(object):
         members = labels == heaviest
         cluster = pf.stats(self._poses[members], self._weights[members])
         whole = pf.stats(self._poses, self._weights)
-        return Estimate(self._refined(tuple(float(value) for value in cluster.mean)), whole.covariance,
-                        cluster.covariance, float(cluster.weight), int(count))
+        return Estimate(self._refined(tuple(float(value) for value in cluster.mean), cluster.covariance),
+                        whole.covariance, cluster.covariance, float(cluster.weight), int(count))
 
-    def _refined(self, mean):
-        """The mean matched to the map by the last update's scan, if the match holds (see the module)."""
+    def _refined(self, mean, covariance):
+        """The mean matched to the map by the last update's scan, pulled towards the mean as the cluster's
+        `covariance` (3, 3) says, if the match holds (see the module)."""
         points = self._points
         if self._walls is None or points is None or len(points) < 10:
             return mean
+        information = REFINE_SIGMA ** 2 * np.linalg.inv(np.asarray(covariance) + REFINE_FLOOR * np.eye(3))
         pose, score = matcher.refine(self._walls, points, mean, REFINE_ITERATIONS, prior=mean,
-                                     prior_weight=REFINE_PRIOR)
+                                     prior_weight=information)
         if score < REFINE_SHARE * len(points) or math.hypot(pose[0] - mean[0], pose[1] - mean[1]) > REFINE_LIMIT[0] \
                 or abs(normalize_angle(pose[2] - mean[2])) > REFINE_LIMIT[1]:
             return mean

@@ -177,9 +177,18 @@ def refine(field, points, pose, iterations, prior=None, prior_weight=0.0, reach=
     (a wall the map does not have yet), and far ones count less (Cauchy weights, scale
     sigma). `prior` (x, y, yaw), if given, pulls as much as `prior_weight` points would (its
     heading with a lever of 1 m): it holds the pose where no wall does, as along a corridor,
-    and barely moves it where a few hundred points agree. Returns the pose and its score."""
+    and barely moves it where a few hundred points agree. `prior_weight` may also be a (3, 3)
+    information matrix on (x, y, yaw) in the same units (points' worth), to pull more in some
+    directions than in others. Returns the pose and its score."""
     reach = 3.0 * field.sigma if reach is None else reach
     pose = np.array(pose, dtype=float)
+    root = None
+    if prior is not None:
+        weight = np.asarray(prior_weight, dtype=float)
+        root = (math.sqrt(max(float(weight), 0.0)) * np.eye(3) if weight.ndim == 0
+                else np.linalg.cholesky(weight).T)  # root.T @ root == the information
+        if not root.any():
+            root = None
     for _ in range(iterations):
         cos, sin = math.cos(pose[2]), math.sin(pose[2])
         turned = np.stack((cos * points[:, 0] - sin * points[:, 1], sin * points[:, 0] + cos * points[:, 1]), axis=-1)
@@ -198,10 +207,10 @@ def refine(field, points, pose, iterations, prior=None, prior_weight=0.0, reach=
         jacobian = np.einsum('nij,njk->nik', pairing, moving)
         weight = np.sqrt(1.0 / (1.0 + np.sum(residual ** 2, axis=1) / field.sigma ** 2))[:, None]
         rows, values = (jacobian * weight[:, :, None]).reshape(-1, 3), -(residual * weight).ravel()
-        if prior is not None and prior_weight > 0:
-            towards = (prior[0] - pose[0], prior[1] - pose[1], normalize_angle(prior[2] - pose[2]))
-            rows = np.vstack((rows, math.sqrt(prior_weight) * np.eye(3)))
-            values = np.concatenate((values, math.sqrt(prior_weight) * np.array(towards)))
+        if root is not None:
+            towards = np.array((prior[0] - pose[0], prior[1] - pose[1], normalize_angle(prior[2] - pose[2])))
+            rows = np.vstack((rows, root))
+            values = np.concatenate((values, root.dot(towards)))
         step = np.linalg.lstsq(rows, values, rcond=1e-6)[0]
         # One pairing is only good nearby: no step longer than a cell or a twentieth of a radian.
         step /= max(1.0, math.hypot(step[0], step[1]) / field.grid.resolution, abs(step[2]) / 0.05)
