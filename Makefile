@@ -6,7 +6,7 @@ WS := .ws
 PYTHON := $(CURDIR)/$(VENV)/bin/python3
 IN_ROS := source setup.bash &&
 
-.PHONY: setup apt demo test unit integration lint bench soak speed-agreement clean
+.PHONY: setup apt demo test unit integration lint bench soak repeat speed-agreement clean
 
 setup: apt $(VENV)/.ready $(WS)/devel/.ready
 
@@ -62,6 +62,11 @@ speed-agreement: setup
 
 soak: setup
 	$(IN_ROS) python3 tools/soak.py --check
+
+# A system test file run RUNS times (default 20) beside BUSY busy cores (default 1), K its -k:
+# make repeat TEST=test/system/test_navigation.py RUNS=20 [K=...] [BUSY=...]
+repeat: setup
+	$(IN_ROS) python3 tools/repeat.py $(TEST) $(if $(RUNS),--runs $(RUNS)) $(if $(BUSY),--busy $(BUSY)) $(if $(K),-k '$(K)')
 
 clean:
 	rm -rf $(WS) $(VENV)

@@ -130,7 +130,7 @@ def _say(message):
     print(message, flush=True)
 
 
-def _minutes(seconds):
+def minutes(seconds):
     return '%d:%02d' % divmod(int(round(seconds)), 60)
 
 
@@ -157,7 +157,7 @@ class Runner(object):
         process = Process(part.name, ['bash', '-c', part.command], self.log_dir, env=environment)
         self.started[part.name] = (process, time.monotonic())
         others = [other.name for other in self.schedule.running if other is not part]
-        _say('== %s: started at %s (%d slot%s%s)' % (part.name, _minutes(time.monotonic() - self.t0), part.slots,
+        _say('== %s: started at %s (%d slot%s%s)' % (part.name, minutes(time.monotonic() - self.t0), part.slots,
                                                     '' if part.slots == 1 else 's',
                                                     ', beside ' + ', '.join(others) if others else ''))
 
@@ -185,7 +185,7 @@ class Runner(object):
                                   for pid, command in left))
         self.results.append((part, start - self.t0, took, self.cpu.get(part.name), failures))
         _say('== %s: %s after %s' % (part.name, 'FAILED (%s)' % '; '.join(failures) if failures else 'passed',
-                                      _minutes(took)))
+                                      minutes(took)))
         sys.stdout.write(process.output(last=1 << 24))
         _say('== end of %s' % part.name)
 
@@ -220,11 +220,11 @@ def table(results, total, load=None):
     (its whole process tree's), and outcome, in start order."""
     lines = ['%-38s %5s %7s %7s %7s  %s' % ('part', 'slots', 'start', 'took', 'CPU', 'result')]
     for part, start, took, cpu, failures in sorted(results, key=lambda result: result[1]):
-        lines.append('%-38s %5d %7s %7s %7s  %s' % (part.name, part.slots, _minutes(start), _minutes(took),
-                                                     '-' if cpu is None else _minutes(cpu),
+        lines.append('%-38s %5d %7s %7s %7s  %s' % (part.name, part.slots, minutes(start), minutes(took),
+                                                     '-' if cpu is None else minutes(cpu),
                                                      'FAILED' if failures else 'passed'))
     cpu = sum(result[3] or 0.0 for result in results)
-    lines.append('%-38s %5s %7s %7s %7s' % ('make test', '', '', _minutes(total), _minutes(cpu)))
+    lines.append('%-38s %5s %7s %7s %7s' % ('make test', '', '', minutes(total), minutes(cpu)))
     if load is not None:
         lines.append('%d cores; load average (1 min) %.1f at the start, %.1f at the end'
                      % (os.cpu_count(), load, os.getloadavg()[0]))

@@ -3,6 +3,9 @@
 No rospy here: a path is a list of (stamp_s, x_m, y_m, yaw_rad) samples, a run
 a `RunResult`; `summarize` turns a run into end poses and errors, `table`
 into text, `plot_paths` into a picture (matplotlib, Agg backend).
+
+`figure` prints a measured number as a line that tools/repeat.py gathers
+across runs of a test (`map_figures`: those of a map that a bound judges).
 """
 import math
 from collections import namedtuple
@@ -88,6 +91,22 @@ def table(run):
             % (summary.drift_distance, math.degrees(summary.drift_heading)),
         ]
     return lines
+
+
+def figure(name, value, worse='max', unit=''):
+    """Prints `FIGURE <name> <value> <worse> [<unit>]`: a number a bound judges, where
+    `worse` says which way is worse ('max': larger, 'min': smaller)."""
+    if worse not in ('max', 'min') or not name or any(c.isspace() for c in name + unit):
+        raise ValueError('figure(%r, %r, %r, %r): a name and unit without spaces, worse max or min'
+                         % (name, value, worse, unit))
+    print(' '.join(['FIGURE', name, '%.6g' % value, worse, unit]).rstrip(), flush=True)
+
+
+def map_figures(prefix, quality):
+    """The figures of a map_quality.MapQuality that its goals judge, named `prefix`_<measure>."""
+    figure(prefix + '_occupied_near_surface', 100 * quality.occupied_near_surface, 'min', '%')
+    figure(prefix + '_surface_covered', 100 * quality.surface_covered, 'min', '%')
+    figure(prefix + '_wall_thickness', quality.wall_thickness, 'max', 'cells')
 
 
 def plot_paths(runs, filename, title):

@@ -26,6 +26,7 @@ import pytest
 import rospkg
 import yaml
 
+from tb3_harness.report import figure
 from tb3_harness.screen import save_png, screenshot, start_xvfb
 from tb3_system_utils import run, wait_until
 
@@ -103,6 +104,9 @@ def test_map_save_and_navigate_as_the_emanual_does(ros_port, processes, desktop)
     walls, floor = colour_pixels(mapping, WALL, 8), colour_pixels(mapping, FLOOR, 8)
     scan = colour_pixels(mapping, (0, 255, 0), 40)
     print('MEASURED rviz during SLAM: %d wall pixels, %d floor pixels, %d scan pixels' % (walls, floor, scan))
+    figure('slam_rviz_wall_pixels', walls, 'min', 'px')
+    figure('slam_rviz_floor_pixels', floor, 'min', 'px')
+    figure('slam_rviz_scan_pixels', scan, 'min', 'px')
     assert walls > 2000 and floor > 20000 and scan > 300
 
     saved = run(bash('rosrun map_server map_saver -f ~/map'), TIMEOUT)
@@ -140,6 +144,8 @@ def test_map_save_and_navigate_as_the_emanual_does(ros_port, processes, desktop)
     costmap_cyan = colour_pixels(image, (0, 255, 255), 60)
     print('MEASURED rviz while navigating: %d plan pixels, %d particle pixels, %d costmap (cyan) pixels'
           % (plan, particles, costmap_cyan))
+    figure('nav_rviz_particle_pixels', particles, 'min', 'px')
+    figure('nav_rviz_costmap_pixels', costmap_cyan, 'min', 'px')
     assert particles > 50 and costmap_cyan > 200
     assert goal.wait(TIMEOUT) == 0, goal.describe()
     assert wait_until(lambda: not result.running(), 180), 'no move_base result within 180 s'

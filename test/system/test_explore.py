@@ -21,6 +21,7 @@ from tb3_harness import exploring
 from tb3_harness.mapping import _node_pid
 from tb3_harness.measure import cpu_seconds
 from tb3_harness.processes import Process, start_master, wait_until
+from tb3_harness.report import figure, map_figures
 from tb3_harness.screen import save_png, screenshot, start_xvfb
 
 from test_emanual import FLOOR, SHOTS, WALL, colour_pixels, map_view
@@ -68,9 +69,15 @@ def test_exploration_maps_turtlebot3_world_alone(tmp_path, monkeypatch):
     view = map_view(pictures[0])
     walls, floor = colour_pixels(view, WALL, 8), colour_pixels(view, FLOOR, 8)
     print('MEASURED rviz after exploring: %d wall pixels, %d floor pixels' % (walls, floor))
+    figure('explore_rviz_wall_pixels', walls, 'min', 'px')
+    figure('explore_rviz_floor_pixels', floor, 'min', 'px')
     assert walls > 2000 and floor > 20000  # the map, shown in rviz
     quality = run.quality
     print('MEASURED %s' % run.summary())
+    figure('explore_free_floor_mapped', 100 * quality.free_floor_mapped, 'min', '%')
+    map_figures('explore_map', quality)
+    figure('explore_clearance', run.clearance, 'min', 'm')
+    figure('explore_goals', run.goals, 'min')
     assert 'no frontier' in run.done_text and 'boxed in' not in run.done_text, run.done_text
     assert quality.free_floor_mapped >= FREE_FLOOR_GOAL, quality.summary()
     assert not quality.failures(), quality.failures()
@@ -98,6 +105,7 @@ def test_a_boxed_in_robot_ends_with_a_clear_message_and_then_idles(tmp_path):
         master.stop()
     print('MEASURED boxed in: %r; %d goals sent; afterwards %d lines and %.1f %% of a core in %.0f s'
           % (done.group(0), goals, lines, 100 * cpu, IDLE_WATCH))
+    figure('boxed_in_idle_cpu', 100 * cpu, 'max', '%')
     assert 'boxed in' in done.group(2), done.group(0)
     assert goals == 0
     assert lines == 0 and cpu < IDLE_CPU
@@ -127,6 +135,7 @@ def test_a_move_base_that_aborts_every_goal_makes_exploration_stop(tmp_path):
         master.stop()
     print('MEASURED every goal aborted: %r; %d goals sent, %d aborted by the stand-in; afterwards %d lines and '
           '%.1f %% of a core in %.0f s' % (done.group(0), goals, aborted, lines, 100 * cpu, IDLE_WATCH))
+    figure('all_aborted_idle_cpu', 100 * cpu, 'max', '%')
     assert 'blacklisted' in done.group(2) and 'boxed in' not in done.group(2), done.group(0)
     assert goals >= 2 and aborted == goals == int(done.group(8)), (goals, aborted, done.group(0))
     assert lines == 0 and cpu < IDLE_CPU

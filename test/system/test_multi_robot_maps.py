@@ -25,6 +25,7 @@ from tb3_harness import exploring
 from tb3_harness.map_quality import measure
 from tb3_harness.navigating import BURGER_FOOTPRINT, clearance
 from tb3_harness.processes import Process, start_master, wait_until
+from tb3_harness.report import figure
 from tb3_navigation.map_files import load_map
 from tb3_sim_nav.world_file import load_world
 
@@ -98,6 +99,10 @@ def test_three_robots_each_map_their_own_part_of_the_house(house):
         print('MEASURED %s: %d goals in %.0f s of sim time, %.1f m2 free mapped, occupied near a surface %.1f %%, '
               'footprint at least %.3f m from the house' % (name, goals, last, free,
                                                            100 * quality.occupied_near_surface, least))
+        figure('robot_goals', goals, 'min')
+        figure('robot_free_mapped', free, 'min', 'm2')
+        figure('robot_occupied_near_surface', 100 * quality.occupied_near_surface, 'min', '%')
+        figure('robot_clearance', least, 'min', 'm')
         assert len(path['map']) > 100  # its pose in its own map, tb3_N/map -> tb3_N/base_footprint
         assert goals >= 2 and free >= MIN_FREE
         assert quality.occupied_near_surface >= 0.95, quality.summary()

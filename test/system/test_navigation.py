@@ -20,6 +20,7 @@ import rospkg
 
 from tb3_harness.navigating import Navigation, clearance
 from tb3_harness.processes import Process, start_master, wait_until
+from tb3_harness.report import figure
 
 SPAWN = (-2.0, -0.5, 0.0)  # tb3_world.launch's
 #: Around and between the pillars (0.15 m radius, 1.1 m apart).
@@ -80,6 +81,10 @@ def test_four_goals_around_the_pillars_succeed_within_the_tolerances(navigation)
               '(amcl %.3f m off); footprint at least %.3f m from the world'
               % (goal + (outcome.state, outcome.sim_seconds, outcome.xy_error, outcome.yaw_error,
                          outcome.amcl_error, least)))
+        figure('goal_xy_error', outcome.xy_error, 'max', 'm')
+        figure('goal_yaw_error', outcome.yaw_error, 'max', 'rad')
+        figure('goal_amcl_error', outcome.amcl_error, 'max', 'm')
+        figure('goal_clearance', least, 'min', 'm')
         assert outcome.state == 'SUCCEEDED', (goal, outcome.state, outcome.text)
         assert outcome.xy_error <= XY_TOLERANCE and outcome.yaw_error <= YAW_TOLERANCE, outcome
         assert least >= CLEARANCE, (goal, least)
@@ -105,6 +110,8 @@ def test_a_cancel_preempts_and_the_robot_stands_still_within_2_s(navigation):
     moved = math.hypot(b[1] - a[1], b[2] - a[2])
     print('MEASURED cancel after 3 s: %s; between %.1f and %.1f s after it the robot moved %.4f m'
           % (outcome.state, a[0] - cancelled, b[0] - cancelled, moved))
+    figure('cancel_moved', moved, 'max', 'm')
+    figure('cancel_turned', abs(b[3] - a[3]), 'max', 'rad')
     assert moved < 0.005 and abs(b[3] - a[3]) < 0.01
 
 
@@ -125,6 +132,8 @@ def test_a_box_spawned_on_the_way_is_driven_around(navigation):
     from_box = clearance(outcome.path, [box_obstacle()], BURGER_FOOTPRINT)
     print('MEASURED past the box: %s in %.1f s of sim time, %.3f m off; footprint at least %.3f m from the world, '
           '%.3f m from the box' % (outcome.state, outcome.sim_seconds, outcome.xy_error, least, from_box))
+    figure('box_detour_clearance', least, 'min', 'm')
+    figure('box_clearance', from_box, 'min', 'm')
     assert outcome.state == 'SUCCEEDED', outcome.text
     # The box leaves 0.25 m to the pillar north of it and about 0.4 m to the wall south of it: the way
     # round it is narrow, and the costmap knows only the sides the lidar has seen (as the unit test).

@@ -25,6 +25,7 @@ import subprocess
 import yaml
 
 from tb3_harness.processes import Process, start_master, tail, wait_until
+from tb3_harness.report import figure
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 BOOK = os.path.join(REPO, 'test', 'data', 'rbx1_nav')
@@ -70,6 +71,8 @@ def test_move_base_square_unchanged_drives_the_square_and_comes_home(tmp_path):
         succeeded = square.output(100000).count('Goal succeeded!')
         print('MEASURED move_base_square.py: exit %s, %d goals succeeded, the robot ends at (%.3f, %.3f, %.3f)'
               % (square.popen.returncode, succeeded, x, y, yaw))
+        figure('square_end_offset', max(abs(x), abs(y)), 'max', 'm')
+        figure('square_end_yaw', abs(yaw), 'max', 'rad')
         assert square.popen.returncode == 0, tail(square.log)
         assert succeeded == 4, square.output()
         assert abs(x) < 0.1 and abs(y) < 0.1 and abs(yaw) < 0.2

@@ -14,6 +14,7 @@ import pytest
 
 from tb3_harness import mapping
 from tb3_harness.processes import start_master
+from tb3_harness.report import figure, map_figures
 
 POSE_ERROR = (0.05, 2.0)     # m, deg: the pose in map against the truth at the end of the loop
 SAME_POSE = 0.01             # m between the two factors' ends in map
@@ -42,6 +43,9 @@ def test_the_slam_corrects_odometry_and_its_map_lies_on_the_walls(runs, factor):
           'odometry %.3f m %.2f deg; SLAM CPU %.0f %% of a core; map: %s'
           % (factor, mapping.path_length(run.truth), run.sim_seconds, run.wall_seconds, run.map_error[0], run.map_error[1],
              run.odom_error[0], run.odom_error[1], 100 * run.slam_cpu, quality.summary()))
+    figure('slam_pose_error', run.map_error[0], 'max', 'm')
+    figure('slam_heading_error', abs(run.map_error[1]), 'max', 'deg')
+    map_figures('slam_map', quality)
     assert run.map_error[0] < POSE_ERROR[0] and abs(run.map_error[1]) < POSE_ERROR[1], run.map_error
     assert run.odom_error[0] > run.map_error[0], (run.odom_error, run.map_error)
     assert not quality.failures(), quality.failures()
@@ -53,6 +57,8 @@ def test_lockstep_gives_the_same_map_at_factors_1_and_0(runs):
     shares = [near_share(a, b) for a, b in ((fast, real), (real, fast))]
     print('MEASURED factors 0 and 1: ends in map %.4f m apart; occupied cells with a match within a cell: '
           '%.3f and %.3f' % (moved, shares[0], shares[1]))
+    figure('lockstep_ends_apart', moved, 'max', 'm')
+    figure('lockstep_cells_matched', 100 * min(shares), 'min', '%')
     assert moved < SAME_POSE
     assert min(shares) >= SAME_MAP_SHARE, shares
 
