@@ -182,11 +182,15 @@ class Lockstep(object):
                 break
             if time.monotonic() > deadline:
                 self._behind.update(pending)
-                # Information, not a fault: at real time nothing waits for
-                # a busy node either (Gazebo never does).
+                # Not a fault (Gazebo never waits for a node), but from here on
+                # that node's commands may land later in sim time than on a
+                # quiet machine: say so where the user looks, with the remedy.
                 if self._warnings.allow('lockstep'):
-                    rospy.loginfo('lockstep: %s did not wait for /clock within %g s (wall); stepping on '
-                                  'without it until it does (at most one such message per %g s)',
+                    rospy.logwarn('lockstep: %s did not react to /clock within %g s (wall): stepping on without it '
+                                  'until it waits again, so what it sends may land later in sim time than on a '
+                                  'quiet machine, and a script may overshoot. For the same result every time: fewer '
+                                  'programs beside it, a lower real_time_factor, or a longer ~lockstep_timeout (at '
+                                  'most one such message per %g s)',
                                   ', '.join(pending), self._timeout, self._warn_period)
                 return
             time.sleep(self._poll)
