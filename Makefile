@@ -4,7 +4,8 @@ SHELL := /bin/bash
 VENV := .venv
 WS := .ws
 PYTHON := $(CURDIR)/$(VENV)/bin/python3
-IN_ROS := source setup.bash &&
+# The harness (tools/tb3_harness) is on the path of make's commands, not of a user's shell.
+IN_ROS := source setup.bash && export PYTHONPATH="$(CURDIR)/tools:$$PYTHONPATH" &&
 
 .PHONY: setup apt demo test unit integration lint bench soak repeat speed-agreement clean
 
@@ -18,21 +19,22 @@ $(VENV)/.ready: tools/requirements.txt
 	$(VENV)/bin/pip install --quiet --disable-pip-version-check -r tools/requirements.txt
 	touch $@
 
-# The workspace's copy of the package is a folder of links to the repo's
-# top-level entries, not one link to the repo: rosrun searches the package
-# folder with `find -L`, which would loop through $(WS) and crawl $(VENV).
-# gazebo_msgs, map_server and tb3_navigation, package folders inside this one,
-# get a link each: catkin does not look for packages inside a package.
+# The workspace's copy of the root package (tb3_sim_nav) is a folder of links
+# to the repo's top-level entries, not one link to the repo: rosrun searches the
+# package folder with `find -L`, which would loop through $(WS) and crawl
+# $(VENV). Every package of packages/ gets a link of its own beside it.
 # catkin_make again whenever what it generates from could have changed.
-INNER_PACKAGES := gazebo_msgs map_server tb3_navigation
-INNER_FILES := $(foreach package,$(INNER_PACKAGES),$(package)/CMakeLists.txt $(package)/package.xml \
-  $(wildcard $(package)/setup.py $(package)/msg/* $(package)/srv/* $(package)/scripts/* $(package)/test/*.test))
-$(WS)/devel/.ready: CMakeLists.txt package.xml setup.py env-hooks/* $(wildcard cfg/*) $(wildcard scripts/*) $(wildcard test/*.test) $(INNER_FILES) | $(VENV)/.ready
+PACKAGES := $(notdir $(wildcard packages/*))
+PACKAGE_FILES := $(foreach package,$(PACKAGES),$(wildcard packages/$(package)/CMakeLists.txt packages/$(package)/package.xml \
+  packages/$(package)/setup.py packages/$(package)/msg/* packages/$(package)/srv/* packages/$(package)/cfg/* \
+  packages/$(package)/scripts/* packages/$(package)/nodes/* packages/$(package)/test/*.test))
+$(WS)/devel/.ready: CMakeLists.txt package.xml setup.py $(wildcard cfg/*) $(wildcard scripts/*) $(wildcard test/*.test) $(PACKAGE_FILES) | $(VENV)/.ready
 	[ ! -L $(WS)/src/tb3_sim_nav ] || rm $(WS)/src/tb3_sim_nav
 	mkdir -p $(WS)/src/tb3_sim_nav
+	find $(WS)/src -maxdepth 1 -type l -lname '$(CURDIR)/*' -delete
 	find $(WS)/src/tb3_sim_nav -maxdepth 1 -type l -delete
-	for entry in *; do ln -s "$(CURDIR)/$$entry" "$(WS)/src/tb3_sim_nav/$$entry"; done
-	for package in $(INNER_PACKAGES); do ln -sfn "$(CURDIR)/$$package" "$(WS)/src/$$package"; done
+	for entry in *; do [ "$$entry" = packages ] || ln -s "$(CURDIR)/$$entry" "$(WS)/src/tb3_sim_nav/$$entry"; done
+	for package in $(PACKAGES); do ln -s "$(CURDIR)/packages/$$package" "$(WS)/src/$$package"; done
 	cd $(WS) && catkin_make -DPYTHON_EXECUTABLE=$(PYTHON) -DCATKIN_ENABLE_TESTING=ON > build.log 2>&1 \
 	  || { tail -40 build.log; exit 1; }
 	touch $@
@@ -44,7 +46,7 @@ test: setup
 	$(IN_ROS) bash tools/run_tests.sh
 
 unit: setup
-	$(IN_ROS) python3 -m pytest -q test/unit
+	$(IN_ROS) python3 -m pytest -q test/unit $(wildcard packages/*/test)
 
 integration: setup
 	$(IN_ROS) bash tools/run_tests.sh --integration-only
@@ -52,7 +54,7 @@ integration: setup
 # The packages as the workspace holds them: catkin_lint wants a package's
 # folder named as the package, and a clone's may not be.
 lint: setup
-	$(IN_ROS) catkin_lint --strict -W2 $(foreach package,tb3_sim_nav $(INNER_PACKAGES),"$$(rospack find $(package))")
+	$(IN_ROS) catkin_lint --strict -W2 $(foreach package,tb3_sim_nav $(PACKAGES),"$$(rospack find $(package))")
 
 bench: setup
 	$(IN_ROS) python3 tools/bench.py $(BENCH_ARGS)

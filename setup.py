@@ -5,6 +5,6 @@ from setuptools import setup
 setup(**generate_distutils_setup(
     # transform_utils is a package, not a py_module: catkin's devel-space
     # relays get the folder of a py_module under package_dir wrong.
-    packages=['tb3_sim_nav', 'tb3_sim_nav.ros', 'tb3_harness', 'rbx1_nav', 'transform_utils'],
+    packages=['tb3_sim_nav', 'tb3_sim_nav.ros', 'rbx1_nav', 'transform_utils'],
     package_dir={'': 'src'},
 ))

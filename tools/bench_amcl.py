@@ -22,13 +22,11 @@ import time
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, 'test', 'unit'))
-
-from drives import WORLD_GOALS, WORLD_GOALS_ROUTE, WORLD_LOOP, WORLD_LOOP_START, record_drive  # noqa: E402
-from test_localization import RVIZ_COVARIANCE, TIGHT, run, scan, travelled, world_grid  # noqa: E402
-from tb3_navigation.amcl_config import AmclConfig  # noqa: E402
-from tb3_navigation.localization import Amcl  # noqa: E402
-from tb3_navigation.map_files import load_map  # noqa: E402
+from tb3_harness.drives import (TIGHT, WORLD_GOALS, WORLD_GOALS_ROUTE, WORLD_LOOP, WORLD_LOOP_START, record_drive,
+                                run, scan, travelled, world_grid)
+from tb3_navigation.amcl_config import AmclConfig
+from tb3_navigation.localization import RVIZ_COVARIANCE, Amcl
+from tb3_common.map_files import load_map
 
 AT_GOAL = 0.05  # m: a scan taken this near a goal counts as one at the goal
 

@@ -18,16 +18,15 @@ import time
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, 'test', 'unit'))
 
-from nav_sim import SCAN_POSE, Lidar, costmaps, world_cut  # noqa: E402 (the tests' world, lidar and map)
-from tb3_harness.measure import machine  # noqa: E402
-from tb3_navigation.controller import DwaController, dwa_config  # noqa: E402
-from tb3_navigation.costmap import Costmap, CostmapConfig  # noqa: E402
-from tb3_navigation.grid import Grid  # noqa: E402
-from tb3_navigation.planner import GlobalPlanner, plan_length  # noqa: E402
-from tb3_navigation.pose2d import compose  # noqa: E402
-from tb3_sim_nav import world_map  # noqa: E402
+from tb3_harness.nav_sim import SCAN_POSE, Lidar, costmaps, world_cut (the tests' world, lidar and map)
+from tb3_harness.measure import machine
+from tb3_navigation.controller import DwaController, dwa_config
+from tb3_navigation.costmap import Costmap, CostmapConfig
+from tb3_common.grid import Grid
+from tb3_navigation.planner import GlobalPlanner, plan_length
+from tb3_common.pose2d import compose
+from tb3_sim_nav import world_map
 
 
 def timed(function, runs):

@@ -20,15 +20,14 @@ import time
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, 'test', 'unit'))
 
-from drives import (HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, path_length,  # noqa: E402
+from tb3_harness.drives import (HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, path_length,
                     record_drive)
-from tb3_harness.map_quality import measure as map_quality  # noqa: E402
-from tb3_navigation.pose2d import normalize_angle  # noqa: E402
-from tb3_navigation.scan import Scan  # noqa: E402
-from tb3_navigation.slam import Slam  # noqa: E402
-from tb3_sim_nav.world_file import load_world  # noqa: E402
+from tb3_harness.map_quality import measure as map_quality
+from tb3_common.pose2d import normalize_angle
+from tb3_navigation.scan import Scan
+from tb3_navigation.slam import Slam
+from tb3_sim_nav.world_file import load_world
 
 #: The whole of turtlebot3_house's rooms from tb3_house.launch's spawn pose and back: 75 m.
 HOUSE_ROUND = [(-1.0, 1.2), (-1.0, 4.0), (-4.0, 4.0), (-4.4, 3.3), (-6.3, 3.3), (-6.3, 1.6), (-6.3, 0.3),

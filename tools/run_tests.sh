@@ -17,6 +17,8 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 export ROS_HOSTNAME=localhost
+# The harness (tools/tb3_harness) for every part, also when run outside make.
+case ":${PYTHONPATH:-}:" in *":$PWD/tools:"*) ;; *) export PYTHONPATH="$PWD/tools${PYTHONPATH:+:$PYTHONPATH}" ;; esac
 unset ROS_IP
 logs=$(mktemp -d)
 plan=$logs/plan
@@ -37,7 +39,7 @@ part() {
 # catkin_lint of the packages as the workspace holds them: its folder named as the package.
 lint() {
   local output
-  output=$(catkin_lint --strict -W2 $(for package in tb3_sim_nav gazebo_msgs map_server tb3_navigation; do
+  output=$(catkin_lint --strict -W2 $(for package in tb3_sim_nav $(ls packages); do
     echo "$(rospack find $package)"; done) 2>&1)
   echo "$output"
   ! echo "$output" | grep -qE ': (error|warning|notice):'
@@ -77,7 +79,8 @@ part 1 rostests "cd .ws && timeout --signal=INT --kill-after=60 3600 catkin_make
 part 2 test_explore "$pytest test/system/test_explore.py"
 part 2 test_multi_robot_maps "$pytest test/system/test_multi_robot_maps.py"
 part 2 test_emanual "$pytest test/system/test_emanual.py"
-[ -n "$integration_only" ] || part 2 unit "$pytest test/unit"
+# The root package's unit tests and every package's own (packages/*/test).
+[ -n "$integration_only" ] || part 2 unit "$pytest test/unit $(ls -d packages/*/test)"
 part 2 test_calibration.busy_core "$pytest test/system/test_calibration.py -k busy_core"
 # Both `make demo`s (as fast as possible) write demo_output/: one after the other, in one share.
 part 2 demos "$pytest test/system/test_readme_walkthrough.py test/system/test_calibration.py -k make_demo"

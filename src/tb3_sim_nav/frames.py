@@ -3,12 +3,12 @@
 This is the simulator core's one pose convention: bodies, robots, spawns and
 readings all speak it. A pose given as x, y, z and a heading (launch
 arguments, world files) becomes one through `planar`. Yaw <-> quaternion is
-written once for the whole project, in tb3_navigation.pose2d.
+written once for the whole project, in tb3_common.pose2d.
 """
 import math
 
 import numpy as np
-from tb3_navigation.pose2d import quaternion_of_yaw, yaw_of_quaternion
+from tb3_common.pose2d import quaternion_of_yaw, yaw_of_quaternion
 
 IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 

@@ -39,7 +39,7 @@ Obstacle = namedtuple('Obstacle', 'kind size position yaw color name', defaults=
 #: `model` (burger, waffle, waffle_pi or a URDF path), `position` (x, y, z), `yaw`.
 RobotSpec = namedtuple('RobotSpec', 'name model position yaw')
 
-#: A world: its obstacles and its robots; `map` the tb3_navigation.map_files.LoadedMap it was built of, if any.
+#: A world: its obstacles and its robots; `map` the tb3_common.map_files.LoadedMap it was built of, if any.
 WorldSpec = namedtuple('WorldSpec', 'obstacles robots map', defaults=(None,))
 MAP_WALL_HEIGHT = 0.5  # m: above every TurtleBot3's lidar (0.182 m on the Burger), low enough to see over in rviz
 MAP_WALL_COLOR = (0.55, 0.6, 0.65, 1.0)
@@ -189,8 +189,8 @@ def map_obstacles(grid, occupied, wall_height=MAP_WALL_HEIGHT):
 
 
 def _map_world(path, wall_height):
-    from tb3_navigation.grid import OCCUPIED
-    from tb3_navigation.map_files import MapFileError, load_map
+    from tb3_common.grid import OCCUPIED
+    from tb3_common.map_files import MapFileError, load_map
     try:
         loaded = load_map(path)
     except MapFileError as error:

@@ -12,7 +12,7 @@ outline of each obstacle).
 import math
 
 import numpy as np
-from tb3_navigation.grid import FREE, OCCUPIED, UNKNOWN, Grid
+from tb3_common.grid import FREE, OCCUPIED, UNKNOWN, Grid
 
 BURGER_SCAN_HEIGHT = 0.182  # m: base_scan above the ground on the Burger (and lower on the Waffles: 0.132)
 
@@ -108,7 +108,7 @@ OVERLAP = 1e-3
 
 
 def rasterise(obstacles, grid):
-    """True [iy, ix] where an obstacle covers any part of a cell of `grid` (a tb3_navigation.grid.Grid):
+    """True [iy, ix] where an obstacle covers any part of a cell of `grid` (a tb3_common.grid.Grid):
     exact for boxes (separating axes) and cylinders (the cell's nearest point)."""
     covered = np.zeros(grid.shape, dtype=bool)
     half = grid.resolution / 2.0

@@ -16,7 +16,7 @@ import argparse
 import os
 import sys
 
-from tb3_navigation.map_files import MapFileError, SaverConfig, save_map
+from tb3_common.map_files import MapFileError, SaverConfig, save_map
 
 from .world_file import WorldError, load_world
 from .world_map import BURGER_SCAN_HEIGHT, map_of_world

@@ -10,12 +10,14 @@ physics is paused); sim-time durations are waited for as the condition
 import atexit
 import math
 import os
+import sys
 import threading
 import time
 from collections import namedtuple
 
 import rospy
 from nav_msgs.msg import Odometry
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.realpath(__file__)), '..', '..', 'tools'))  # the harness
 from tb3_harness.processes import Process
 
 GROUND_TRUTH = '/base_pose_ground_truth'

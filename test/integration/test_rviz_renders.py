@@ -28,6 +28,7 @@ image must also be shown beside the 3D view: its Image panel, in the left
 dock, holds the pillars' green, which nothing else in the dock is.
 """
 import os
+import sys
 import time
 import unittest
 
@@ -37,6 +38,7 @@ import rospy
 import rostest
 import yaml
 from geometry_msgs.msg import Twist
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.realpath(__file__)), '..', '..', 'tools'))  # the harness
 from tb3_harness.screen import green_pixels, save_png, screenshot, start_xvfb
 
 from tb3_test_utils import Child, init_test_node, report, wait_for

@@ -8,7 +8,7 @@ import actionlib
 import rospy
 from move_base_msgs.msg import MoveBaseAction, MoveBaseResult
 
-from tb3_navigation.ros import lifecycle
+from tb3_common.ros import lifecycle
 
 
 def main():

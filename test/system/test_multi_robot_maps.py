@@ -26,7 +26,7 @@ from tb3_harness.map_quality import measure
 from tb3_harness.navigating import BURGER_FOOTPRINT, clearance
 from tb3_harness.processes import Process, start_master, wait_until
 from tb3_harness.report import figure
-from tb3_navigation.map_files import load_map
+from tb3_common.map_files import load_map
 from tb3_sim_nav.world_file import load_world
 
 ROBOTS = {'tb3_0': (-7.0, -1.0), 'tb3_1': (7.0, -1.0), 'tb3_2': (0.5, 3.0)}  # multi_tb3.launch's spawns

@@ -3,7 +3,7 @@
 HOME is a temporary folder, PATH is Debian's alone (no venv, no workspace
 sourced yet), and the README's placeholder for this repository's address is
 this repository (`git clone` takes its committed HEAD). The block builds
-tb3_sim_nav, gazebo_msgs, map_server and tb3_navigation with catkin_make; sourced, the workspace has
+tb3_sim_nav and every package of packages/ with catkin_make; sourced, the workspace has
 the package, gazebo_msgs' python classes and a simulator that serves
 Gazebo's services. (`catkin_make run_tests` and `catkin_test_results`, the
 README's next two commands, are what `make test` runs in make setup's
@@ -19,7 +19,7 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 ADDRESS = "<this repository's address>"
 BLOCK = """mkdir -p ~/catkin_ws/src && cd ~/catkin_ws/src
 git clone <this repository's address> tb3_sim_nav
-ln -s tb3_sim_nav/gazebo_msgs tb3_sim_nav/map_server tb3_sim_nav/tb3_navigation .
+ln -s tb3_sim_nav/packages/* .
 /usr/bin/python3 -m venv --system-site-packages ~/tb3-venv && ~/tb3-venv/bin/pip install pybullet
 cd ~/catkin_ws && catkin_make -DPYTHON_EXECUTABLE=$HOME/tb3-venv/bin/python3
 source devel/setup.bash"""
@@ -34,14 +34,14 @@ def test_the_readme_block_builds_a_workspace_that_runs_the_simulator(tmp_path, p
                           ROS_MASTER_URI=master_uri(port), ROS_HOSTNAME='localhost')
     script = BLOCK.replace(ADDRESS, REPO) + '\nset -e\n' + '\n'.join([
         'rospack find tb3_sim_nav', 'rospack find tb3_sim_bringup',
-        'python3 -c "import gazebo_msgs.srv, tb3_navigation, tb3_sim_nav; print(gazebo_msgs.srv.__file__)"'])
+        'python3 -c "import gazebo_msgs.srv, tb3_common, tb3_navigation, tb3_sim_nav; print(gazebo_msgs.srv.__file__)"'])
     built = subprocess.run(['bash', '-c', 'set -e\n' + script], env=fresh_terminal, stdout=subprocess.PIPE,
                            stderr=subprocess.STDOUT, universal_newlines=True, timeout=BUILD_TIMEOUT)
     workspace = str(tmp_path / 'catkin_ws')
     assert built.returncode == 0, built.stdout[-4000:]
     lines = built.stdout.strip().split('\n')
     assert lines[-3] == os.path.join(workspace, 'src', 'tb3_sim_nav')
-    assert lines[-2] == os.path.join(workspace, 'src', 'tb3_sim_nav', 'bringup', 'tb3_sim_bringup')
+    assert lines[-2] == os.path.join(workspace, 'src', 'tb3_sim_bringup')
     assert lines[-1].startswith(os.path.join(workspace, 'devel'))
 
     in_workspace = 'source %s/devel/setup.bash && ' % workspace

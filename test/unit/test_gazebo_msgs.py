@@ -10,7 +10,7 @@ import pytest
 
 from conftest import REPO
 
-OURS = REPO / 'gazebo_msgs'
+OURS = REPO / 'packages' / 'gazebo_msgs'
 GAZEBOS = REPO / 'test' / 'data' / 'gazebo_msgs_noetic'
 # Gazebo's definitions and the std_msgs/geometry_msgs ones Debian installs
 # (ros-std-msgs, ros-geometry-msgs).

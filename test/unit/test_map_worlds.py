@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from tb3_navigation.grid import Grid
-from tb3_navigation.map_files import load_map
+from tb3_common.grid import Grid
+from tb3_common.map_files import load_map
 from tb3_sim_nav.frames import planar
 from tb3_sim_nav.params import ParameterError, resolve
 from tb3_sim_nav.robot_model import load_model

@@ -14,7 +14,7 @@ import textwrap
 SCENARIO = textwrap.dedent('''
     import os, signal, sys
     from tb3_sim_nav.ros.transport import Backlogs, NonBlockingConnection
-    from tb3_navigation.ros.lifecycle import Life
+    from tb3_common.ros.lifecycle import Life
 
     class SignallingSocket(object):
         """Sends SIGINT to this process from inside its first send()."""
@@ -69,7 +69,7 @@ def test_the_same_moment_deadlocks_a_handler_that_closes_the_connection():
 
 HANGS_ON_ITS_WAY_OUT = textwrap.dedent('''
     import os, signal, threading, time
-    from tb3_navigation.ros import lifecycle
+    from tb3_common.ros import lifecycle
     lifecycle.STACKS_AFTER = 0.5
     life = lifecycle.Life()
     life.handle_signals()
@@ -94,7 +94,7 @@ def test_a_node_still_running_after_its_end_was_asked_for_prints_where_its_threa
 def test_a_callback_does_not_run_once_an_end_was_asked_for_and_a_publish_to_a_closed_topic_ends_it_quietly():
     import faulthandler
     import rospy
-    from tb3_navigation.ros.lifecycle import Life
+    from tb3_common.ros.lifecycle import Life
     life, calls = Life(), []
 
     def publishes(message):  # as amcl's scan callback when rospy closes its topics under it

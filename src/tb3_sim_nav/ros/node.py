@@ -14,7 +14,7 @@ import rospkg
 import rospy
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty, EmptyResponse
-from tb3_navigation.ros import lifecycle
+from tb3_common.ros import lifecycle
 from tf2_msgs.msg import TFMessage
 
 from .. import params

@@ -1,0 +1,211 @@
+"""The localization node: amcl's interface over tb3_navigation.localization.
+
+    rosrun amcl amcl        (tb3_navigation.launch starts it with TurtleBot3's values)
+
+The map comes from the `static_map` service (or the `map` topic with
+~use_map_topic); `scan` and tf odom -> base_footprint drive the filter;
+`initialpose` (rviz's 2D Pose Estimate, in the map frame) restarts it around
+a pose; services `global_localization` and `request_nomotion_update`.
+Out: latched `amcl_pose` and `particlecloud`, tf map -> odom post-dated by
+transform_tolerance (re-sent with each scan, as amcl does). The pose is
+saved to ~initial_pose_* every 1 / save_pose_rate s, so a restarted node
+resumes there, as amcl's does. Each scan is handled in its callback, start to
+end, so a simulator in lockstep waits for it.
+"""
+import dataclasses
+import math
+import threading
+
+import numpy as np
+import rospy
+from geometry_msgs.msg import Pose, PoseArray, PoseWithCovarianceStamped
+from nav_msgs.msg import OccupancyGrid
+from nav_msgs.srv import GetMap, SetMap, SetMapResponse
+from sensor_msgs.msg import LaserScan
+from std_srvs.srv import Empty, EmptyResponse
+
+from tb3_navigation.amcl_config import AmclConfig
+from tb3_navigation.localization import Amcl, covariance_3x3, covariance_6x6
+from tb3_common.pose2d import quaternion_of_yaw, yaw_of_quaternion
+from tb3_navigation.scan import Scan
+from tb3_common.ros import lifecycle, params
+from tb3_common.ros.frames import Frames, namespaced
+from tb3_common.ros.map_messages import grid_of_message
+
+NODE = 'amcl'
+FRAMES = {'odom_frame_id': 'odom', 'base_frame_id': 'base_footprint', 'global_frame_id': 'map'}
+
+
+def _pose_message(pose):
+    message = Pose()
+    message.position.x, message.position.y = pose[0], pose[1]
+    (message.orientation.x, message.orientation.y, message.orientation.z,
+     message.orientation.w) = quaternion_of_yaw(pose[2])
+    return message
+
+
+class AmclNode(object):
+
+    def __init__(self, life):
+        namespace = rospy.get_namespace()
+        frames = dict((name, namespaced(frame, namespace)) for name, frame in FRAMES.items()
+                      if not rospy.has_param('~' + name))
+        self.config = params.read_or_exit(NODE, AmclConfig, overrides=frames)
+        self.use_map_topic = bool(rospy.get_param('~use_map_topic', False))
+        self.save_pose_rate = float(rospy.get_param('~save_pose_rate', 0.5))
+        seed = rospy.get_param('~seed', -1)
+        self.seed = None if seed < 0 else int(seed)
+        self.frames = Frames(NODE)
+        self._lock = threading.Lock()  # the filter, between the scan callback, initialpose and the services
+        self.filter = None
+        self._sensors = {}
+        self._transform = None  # map -> odom of the last update
+        self._last_cloud = self._last_save = None
+        self.pose_pub = rospy.Publisher('amcl_pose', PoseWithCovarianceStamped, queue_size=2, latch=True)
+        self.cloud_pub = rospy.Publisher('particlecloud', PoseArray, queue_size=2, latch=True)
+        rospy.Service('global_localization', Empty, self._on_global_localization)
+        rospy.Service('request_nomotion_update', Empty, self._on_nomotion_update)
+        rospy.Service('set_map', SetMap, self._on_set_map)
+        rospy.Subscriber('initialpose', PoseWithCovarianceStamped, life.callback(self._on_initial_pose), queue_size=2)
+        if self.use_map_topic:
+            rospy.Subscriber('map', OccupancyGrid, life.callback(self._on_map), queue_size=1)
+        else:
+            threading.Thread(target=self._request_map, name='static_map', daemon=True).start()
+        rospy.Subscriber('scan', LaserScan, life.callback(self._on_scan), queue_size=1)
+
+    # --- the map ------------------------------------------------------------------
+    def _request_map(self):
+        rospy.loginfo('%s: requesting the map from static_map...', NODE)
+        while not rospy.core.is_shutdown_requested():
+            try:
+                rospy.wait_for_service('static_map', timeout=5.0)
+                self._on_map(rospy.ServiceProxy('static_map', GetMap)().map)
+                return
+            except (rospy.ROSException, rospy.ServiceException) as error:
+                self.frames.warn('static_map', 'no map yet from static_map (%s): start map_server', error)
+
+    def _on_map(self, message, pose=None, covariance=None):
+        grid, values, _ = grid_of_message(message)
+        with self._lock:
+            self.filter = Amcl(self.config, grid, values, self.seed)
+            if pose is not None:
+                self.filter.initialise(pose, covariance)
+            self._transform = None
+        rospy.loginfo('%s: map of %d x %d cells at %.3f m/cell; particles around (%.2f, %.2f, %.2f)', NODE,
+                      grid.width, grid.height, grid.resolution, *self.filter.estimate().pose)
+
+    # --- requests -----------------------------------------------------------------------
+    def _on_initial_pose(self, message):
+        pose = message.pose.pose
+        yaw = yaw_of_quaternion(pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w)
+        values = (pose.position.x, pose.position.y, yaw)
+        frame = message.header.frame_id.lstrip('/')
+        if frame != self.config.global_frame_id:
+            rospy.logwarn('%s: ignoring an initial pose in frame "%s": initial poses must be in the global frame, '
+                          '"%s"', NODE, frame, self.config.global_frame_id)
+            return
+        covariance = covariance_3x3(message.pose.covariance)
+        if not all(math.isfinite(value) for value in values) or not np.all(np.isfinite(covariance)):
+            rospy.logwarn('%s: ignoring an initial pose with NaN or inf in it: %s', NODE, values)
+            return
+        with self._lock:
+            if self.filter is None:
+                rospy.logwarn('%s: no map yet: the initial pose waits for one', NODE)
+                self.config = dataclasses.replace(self.config, initial_pose_x=values[0], initial_pose_y=values[1],
+                                                  initial_pose_a=values[2])
+                return
+            try:
+                self.filter.initialise(values, covariance)
+            except ValueError as error:
+                rospy.logwarn('%s: ignoring an initial pose: %s', NODE, error)
+                return
+        rospy.loginfo('%s: initial pose (%.3f, %.3f, %.3f) with standard deviations %.2f m, %.2f m, %.2f rad', NODE,
+                      values[0], values[1], values[2], *np.sqrt(np.maximum(np.diag(covariance), 0.0)))
+
+    def _on_global_localization(self, _request):
+        with self._lock:
+            if self.filter is not None:
+                self.filter.global_localization()
+        rospy.loginfo('%s: global localization: particles spread over the free space', NODE)
+        return EmptyResponse()
+
+    def _on_nomotion_update(self, _request):
+        with self._lock:
+            if self.filter is not None:
+                self.filter.request_nomotion_update()
+        return EmptyResponse()
+
+    def _on_set_map(self, request):
+        pose = request.initial_pose.pose.pose
+        self._on_map(request.map, (pose.position.x, pose.position.y, yaw_of_quaternion(
+            pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w)),
+            covariance_3x3(request.initial_pose.pose.covariance))
+        return SetMapResponse(success=True)
+
+    # --- scans -------------------------------------------------------------------------------
+    def _sensor_pose(self, frame):
+        if frame not in self._sensors:
+            pose = self.frames.pose(self.config.base_frame_id, frame, rospy.Time(0), timeout=1.0)
+            if pose is None:
+                return None
+            self._sensors[frame] = pose
+        return self._sensors[frame]
+
+    def _on_scan(self, message):
+        stamp = message.header.stamp
+        sensor = self._sensor_pose(message.header.frame_id)
+        odom = (self.frames.pose(self.config.odom_frame_id, self.config.base_frame_id, stamp, timeout=0.5)
+                if sensor else None)
+        if odom is None:
+            return
+        with self._lock:
+            if self.filter is None:
+                return
+            updated = self.filter.update(odom, Scan.from_message(message), sensor)
+            if updated:
+                self._transform = self.filter.map_to_odom()
+                estimate = self.filter.estimate()
+                if self.filter.resampled:
+                    self._publish_pose(estimate, stamp)
+                self._publish_cloud(self.filter.particles, stamp)
+            transform = self._transform
+        if transform is not None and self.config.tf_broadcast:
+            self.frames.send(self.config.global_frame_id, self.config.odom_frame_id, transform,
+                             stamp + rospy.Duration(self.config.transform_tolerance))
+        if updated:
+            self._save_pose(estimate, stamp)
+
+    def _publish_pose(self, estimate, stamp):
+        message = PoseWithCovarianceStamped()
+        message.header.frame_id, message.header.stamp = self.config.global_frame_id, stamp
+        message.pose.pose = _pose_message(estimate.pose)
+        message.pose.covariance = covariance_6x6(estimate.covariance)
+        self.pose_pub.publish(message)
+
+    def _publish_cloud(self, particles, stamp):
+        rate = self.config.gui_publish_rate
+        if rate > 0 and self._last_cloud is not None and (stamp - self._last_cloud).to_sec() < 1.0 / rate:
+            return
+        self._last_cloud = stamp
+        message = PoseArray()
+        message.header.frame_id, message.header.stamp = self.config.global_frame_id, stamp
+        message.poses = [_pose_message(pose) for pose in particles]
+        self.cloud_pub.publish(message)
+
+    def _save_pose(self, estimate, stamp):
+        """amcl's save_pose_rate: the pose on the parameter server, where a restarted node starts."""
+        if self.save_pose_rate <= 0 or (self._last_save is not None
+                                        and (stamp - self._last_save).to_sec() < 1.0 / self.save_pose_rate):
+            return
+        self._last_save = stamp
+        x, y, yaw = estimate.pose
+        for name, value in (('initial_pose_x', x), ('initial_pose_y', y), ('initial_pose_a', yaw),
+                            ('initial_cov_xx', estimate.covariance[0][0]), ('initial_cov_yy', estimate.covariance[1][1]),
+                            ('initial_cov_aa', estimate.covariance[2][2])):
+            rospy.set_param('~' + name, float(value))
+
+
+def main():
+    life = lifecycle.init_node(NODE)
+    AmclNode(life)
+    life.spin()

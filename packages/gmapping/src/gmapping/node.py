@@ -1,0 +1,130 @@
+"""The SLAM node: gmapping's interface over tb3_navigation.slam.
+
+    roslaunch tb3_sim_bringup tb3_slam.launch      # or: rosrun gmapping slam_gmapping
+
+Subscribes `scan` and tf odom -> base_footprint; publishes latched `map` and
+`map_metadata` (every map_update_interval of scan time, as gmapping), tf
+map -> odom (every transform_publish_period, stamped that far ahead so that
+lookups at a scan's time succeed, as gmapping's); serves `dynamic_map`.
+Each scan is handled in its own callback, start to end, so a simulator in
+lockstep waits for it (and the map does not depend on the speed).
+
+In a namespace (`ROS_NAMESPACE=tb3_0`), frames not given are the namespace's
+(tb3_0/odom, tb3_0/base_footprint, tb3_0/map), as ROBOTIS' multi-robot SLAM
+sets them; topics are the namespace's (/tb3_0/scan, /tb3_0/map).
+"""
+import threading
+
+import rospy
+from nav_msgs.msg import MapMetaData, OccupancyGrid
+from nav_msgs.srv import GetMap, GetMapResponse
+from sensor_msgs.msg import LaserScan
+
+from tb3_navigation.scan import Scan
+from tb3_navigation.slam import Slam, SlamConfig
+from tb3_common.ros import lifecycle, params
+from tb3_common.ros.frames import Frames, namespaced
+from tb3_common.ros.map_messages import occupancy_grid
+
+NODE = 'tb3_slam'
+#: What turtlebot3_slam.launch's slam_methods may ask for: each runs this node (and says so).
+METHODS = ('tb3', 'gmapping', 'cartographer', 'hector', 'karto', 'frontier_exploration')
+
+
+class SlamNode(object):
+
+    def __init__(self, life):
+        self.life = life
+        namespace = rospy.get_namespace()
+        self.base_frame = rospy.get_param('~base_frame', namespaced('base_footprint', namespace))
+        self.odom_frame = rospy.get_param('~odom_frame', namespaced('odom', namespace))
+        self.map_frame = rospy.get_param('~map_frame', namespaced('map', namespace))
+        self.transform_publish_period = float(rospy.get_param('~transform_publish_period', 0.05))
+        self.tf_delay = float(rospy.get_param('~tf_delay', self.transform_publish_period))
+        method = rospy.get_param('~slam_methods', 'tb3')
+        if method not in METHODS:
+            rospy.logfatal('%s cannot start: slam_methods %r: must be one of %s', NODE, method, ', '.join(METHODS))
+            raise SystemExit(2)
+        if method != 'tb3':
+            rospy.loginfo('%s: slam_methods %s asked for; Debian has none of those: running tb3_navigation\'s '
+                          'SLAM (scan-to-map matching) with gmapping\'s interface and TurtleBot3\'s values', NODE,
+                          method)
+        self.config = params.read_or_exit(NODE, SlamConfig)
+        rospy.loginfo('%s: frames %s -> %s -> %s, transform_publish_period %g s', NODE, self.map_frame,
+                      self.odom_frame, self.base_frame, self.transform_publish_period)
+        self.slam = Slam(self.config)
+        self.frames = Frames(NODE)
+        self._lock = threading.Lock()  # the core, between the scan callback and the tf timer and service
+        self._sensors = {}  # scan frame -> its pose in the base frame (static: asked once)
+        self._last_stamp = None
+        self._published_updates = -1
+        self._last_map_stamp = None
+        self._map = None
+        self.map_pub = rospy.Publisher('map', OccupancyGrid, queue_size=1, latch=True)
+        self.metadata_pub = rospy.Publisher('map_metadata', MapMetaData, queue_size=1, latch=True)
+        rospy.Service('dynamic_map', GetMap, self._on_dynamic_map)
+        self.scan_sub = rospy.Subscriber('scan', LaserScan, self._on_scan, queue_size=1)
+        if self.transform_publish_period > 0:
+            threading.Thread(target=self._tf_loop, name='map_to_odom', daemon=True).start()
+
+    def _sensor_pose(self, frame, stamp):
+        if frame not in self._sensors:
+            pose = self.frames.pose(self.base_frame, frame, rospy.Time(0), timeout=1.0)
+            if pose is None:
+                return None
+            self._sensors[frame] = pose
+        return self._sensors[frame]
+
+    def _on_scan(self, message):
+        stamp = message.header.stamp
+        sensor = self._sensor_pose(message.header.frame_id, stamp)
+        odom = self.frames.pose(self.odom_frame, self.base_frame, stamp, timeout=0.5) if sensor else None
+        if odom is None:
+            return
+        with self._lock:
+            if self._last_stamp is not None and stamp < self._last_stamp:
+                rospy.logwarn('%s: time went back (%.2f s -> %.2f s: a simulation reset or a new simulator): '
+                              'starting a new map', NODE, self._last_stamp.to_sec(), stamp.to_sec())
+                self.slam.reset()
+                self._last_map_stamp, self._published_updates = None, -1
+            self._last_stamp = stamp
+            self.slam.update(stamp.to_sec(), odom, Scan.from_message(message), sensor)
+            if self.slam.jumped:
+                rospy.loginfo('%s: the odometry jumped (a reset or a teleport) at %.2f s; the pose in %s is '
+                              '(%.2f, %.2f, %.2f), matched: %s', NODE, stamp.to_sec(), self.map_frame,
+                              *(tuple(self.slam.pose) + (self.slam.matched,)))
+            due = (self._last_map_stamp is None
+                   or (stamp - self._last_map_stamp).to_sec() > self.config.map_update_interval)
+            if due and self.slam.map_updates != self._published_updates:
+                self._map = occupancy_grid(self.slam.grid, self.slam.map_values(), self.map_frame, stamp)
+                self._published_updates, self._last_map_stamp = self.slam.map_updates, stamp
+                self.map_pub.publish(self._map)
+                self.metadata_pub.publish(self._map.info)
+        if self.transform_publish_period <= 0:
+            self._send_map_to_odom()
+
+    def _send_map_to_odom(self):
+        with self._lock:
+            correction = self.slam.map_to_odom
+        self.frames.send(self.map_frame, self.odom_frame, correction,
+                         rospy.Time.now() + rospy.Duration(self.tf_delay))
+
+    def _tf_loop(self):
+        """map -> odom every transform_publish_period of sim time (rospy.Timer's thread would end
+        at the first jump back in time, and wait on a stopped clock)."""
+        while not self.life.stopping:
+            self._send_map_to_odom()
+            self.life.sleep_sim(self.transform_publish_period)
+
+    def _on_dynamic_map(self, _request):
+        with self._lock:
+            if self._map is None:
+                self._map = occupancy_grid(self.slam.grid, self.slam.map_values(), self.map_frame,
+                                             rospy.Time.now())
+            return GetMapResponse(map=self._map)
+
+
+def main():
+    life = lifecycle.init_node(NODE)
+    SlamNode(life)
+    life.spin()

@@ -1,0 +1,361 @@
+"""map_server's files (tb3_common.map_files): read as map_server reads them, written byte for byte
+as map_saver writes them, both ways; ROS by Example's maps; every error names the file and the key."""
+import hashlib
+import math
+import os
+import shutil
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from tb3_common import map_files
+from tb3_common.grid import Grid
+from tb3_common.pose2d import quaternion_of_yaw
+from tb3_common.map_files import MapFileError, SaverConfig
+
+from tb3_harness import ROOT as REPO
+
+FIXTURE = REPO / 'test' / 'data' / 'map_saver'
+RBX1 = REPO / 'maps' / 'rbx1'
+# The fixture's picture (test/data/map_saver/README.md), its first row the highest y.
+FIXTURE_ROWS = ['##########', '#........?', '#.??.....?', '#....##..?', '#........#', '#####....#']
+SHIPPED = ['turtlebot3_world', 'turtlebot3_house', 'turtlebot3_stage_1', 'turtlebot3_stage_2',
+           'turtlebot3_stage_3', 'turtlebot3_stage_4']
+
+
+def _values(rows):
+    """int8 values [iy, ix] of a picture whose first row is the highest y."""
+    code = {'#': 100, '.': 0, '?': -1}
+    return np.array([[code[c] for c in row] for row in reversed(rows)], dtype=np.int8)
+
+
+def _write_yaml(path, **keys):
+    text = ''.join('%s: %s\n' % (key, value) for key, value in keys.items() if value is not None)
+    path.write_text(text)
+    return path
+
+
+def _map_yaml(folder, image='m.png', **changes):
+    keys = dict(image=image, resolution=0.05, origin='[1.0, -2.0, 0.0]', negate=0, occupied_thresh=0.65,
+                free_thresh=0.196)
+    keys.update(changes)
+    return _write_yaml(folder / 'm.yaml', **keys)
+
+
+# --- the format, both ways ---------------------------------------------------------
+def test_a_map_written_as_map_saver_writes_one_loads_to_its_grid():
+    loaded = map_files.load_map(str(FIXTURE / 'fixture.yaml'))
+    assert loaded.grid == Grid(0.05, 10, 6, (-0.25, -0.1, 0.0))
+    assert loaded.values.dtype == np.int8
+    assert np.array_equal(loaded.values, _values(FIXTURE_ROWS))
+    # Cell (0, 0) is the image's bottom-left pixel: occupied, at the origin's corner.
+    assert loaded.values[0, 0] == 100 and loaded.values[0, 5] == 0 and loaded.values[4, 9] == -1
+    assert loaded.metadata.image == str(FIXTURE / 'fixture.pgm')
+
+
+def test_saving_that_grid_writes_map_savers_files_byte_for_byte(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # as `map_saver -f fixture` run in a folder
+    loaded = map_files.load_map(str(FIXTURE / 'fixture.yaml'))
+    pgm, yaml_path = map_files.save_map(loaded.grid, loaded.values, SaverConfig(mapname='fixture'))
+    assert (pgm, yaml_path) == ('fixture.pgm', 'fixture.yaml')
+    assert (tmp_path / 'fixture.pgm').read_bytes() == (FIXTURE / 'fixture.pgm').read_bytes()
+    assert (tmp_path / 'fixture.yaml').read_bytes() == (FIXTURE / 'fixture.yaml').read_bytes()
+
+
+@pytest.mark.parametrize('name', SHIPPED + ['rbx1/test_map', 'rbx1/blank_map'])
+def test_maps_round_trip_load_save_load(name, tmp_path):
+    """File -> grid -> file -> the same grid; and for map_saver's own files the same bytes."""
+    source = REPO / 'maps' / (name + '.yaml')
+    first = map_files.load_map(str(source))
+    base = tmp_path / os.path.basename(name)
+    map_files.save_map(first.grid, first.values, SaverConfig(mapname=str(base)), image=base.name + '.pgm')
+    second = map_files.load_map(str(base) + '.yaml')
+    assert second.grid == first.grid
+    assert np.array_equal(second.values, first.values)
+    if not name.startswith('rbx1'):  # ours were written by map_saver's format; the book's by GIMP
+        assert (tmp_path / (base.name + '.pgm')).read_bytes() == source.with_suffix('.pgm').read_bytes()
+        assert (tmp_path / (base.name + '.yaml')).read_bytes() == source.read_bytes()
+
+
+def test_grid_to_files_to_grid_keeps_every_value_map_saver_can_tell_apart(tmp_path):
+    rng = np.random.default_rng(3)
+    values = rng.integers(-1, 101, size=(37, 53)).astype(np.int8)
+    grid = Grid(0.025, 53, 37, (-1.5, 2.25, 0.0))
+    map_files.save_map(grid, values, SaverConfig(mapname=str(tmp_path / 'r')))
+    loaded = map_files.load_map(str(tmp_path / 'r.yaml'))
+    # map_saver's three classes: 0..25 free, >= 65 occupied, the rest (and -1) unknown.
+    expected = np.where(values >= 65, 100, np.where((values >= 0) & (values <= 25), 0, -1))
+    assert loaded.grid == grid
+    assert np.array_equal(loaded.values, expected)
+
+
+def test_pgm_pixels_follow_occ_and_free_and_the_top_row_is_the_highest_y():
+    values = np.array([[-1, 0, 10, 25, 26, 64, 65, 100], [0, 0, 0, 0, 0, 0, 0, 0]], dtype=np.int8)
+    data = map_files.pgm_bytes(values, 0.05)
+    header = b'P5\n# CREATOR: map_saver.cpp 0.050 m/pix\n8 2\n255\n'
+    assert data[:len(header)] == header
+    assert list(data[len(header):len(header) + 8]) == [254] * 8  # row 1 (higher y) comes first
+    assert list(data[len(header) + 8:]) == [205, 254, 254, 254, 205, 205, 0, 0]
+    # --occ 50 --free 10: 26 and 64 change class.
+    custom = map_files.pgm_bytes(values, 0.05, threshold_occupied=50, threshold_free=10)
+    assert list(custom[len(header) + 8:]) == [205, 254, 254, 205, 205, 0, 0, 0]
+
+
+@pytest.mark.parametrize('resolution, printed', [(0.05, '0.050'), (0.1, '0.100'), (0.0125, '0.013'),
+                                                 (1.0, '1.000')])
+def test_pgm_header_prints_the_resolution_with_three_decimals(resolution, printed):
+    data = map_files.pgm_bytes(np.zeros((1, 1), dtype=np.int8), resolution)
+    assert data.startswith(('P5\n# CREATOR: map_saver.cpp %s m/pix\n1 1\n255\n' % printed).encode())
+
+
+def test_yaml_text_is_map_savers_printf():
+    text = map_files.yaml_text('/home/learner/map.pgm', 0.05, (-10.0, -10.0), (0.0, 0.0, 0.0, 1.0))
+    assert text == ('image: /home/learner/map.pgm\nresolution: 0.050000\norigin: [-10.000000, -10.000000, '
+                    '0.000000]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n\n')
+
+
+def test_yaml_image_is_the_f_argument_as_given_and_the_thresholds_are_always_the_defaults(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / 'sub').mkdir()
+    grid = Grid(0.1, 2, 2, (0.5, -0.25, 0.0))
+    map_files.save_map(grid, np.zeros((2, 2), dtype=np.int8),
+                       SaverConfig(threshold_occupied=90, threshold_free=5, mapname='sub/my_map'))
+    text = (tmp_path / 'sub' / 'my_map.yaml').read_text()
+    assert text.split('\n')[0] == 'image: sub/my_map.pgm'
+    assert 'resolution: 0.100000\norigin: [0.500000, -0.250000, 0.000000]\n' in text
+    assert text.endswith('negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n\n')
+
+
+def test_the_yaml_yaw_is_tf2s_yaw_of_the_origin_quaternion():
+    from tf.transformations import euler_from_quaternion, quaternion_from_euler
+    for roll, pitch, yaw in [(0.0, 0.0, 0.7), (0.0, 0.0, -3.1), (0.3, -0.2, 2.5), (0.0, 0.0, math.pi / 2)]:
+        q = quaternion_from_euler(roll, pitch, yaw)
+        assert map_files.yaw_of_quaternion(*q) == pytest.approx(euler_from_quaternion(q)[2], abs=1e-12)
+        # Not normalised: tf2's Matrix3x3 scales by 2 / |q|^2.
+        assert map_files.yaw_of_quaternion(*(2.0 * q)) == pytest.approx(yaw, abs=1e-12)
+    text = map_files.yaml_text('m.pgm', 0.05, (1.0, 2.0), quaternion_of_yaw(0.785398))
+    assert 'origin: [1.000000, 2.000000, 0.785398]' in text
+
+
+# --- ROS by Example's maps ---------------------------------------------------------
+# sha256 of pirobot/rbx1's files (indigo-devel, rbx1_nav/maps/) and of the note that came with them.
+RBX1_SHA256 = {
+    'README.md': '34855bf842d518a6e6e05f959578e79980dec5ce50dc9d4e0c63d45206819d30',
+    'blank_map.pgm': '143943889a9af4dde127f73759ae94aabab07359486f6e168b1760cb8739d430',
+    'blank_map.yaml': '8b5e2910cd68987e13974618aa51820fedffe7c44430c94d6bfc35361d904e62',
+    'test_map.pgm': '251e0ce358fb7bb6b01ac15972a429bba43318af6950650ca5d88c8dde783367',
+    'test_map.yaml': 'c6c3d328b1ed72a5fcd341c7547c15966d41dc09fe80d912f16557159643a65a',
+}
+
+
+def test_rbx1_maps_are_the_books_unchanged_copies_with_their_attribution():
+    assert sorted(os.listdir(str(RBX1))) == sorted(RBX1_SHA256)
+    for name, digest in RBX1_SHA256.items():
+        assert hashlib.sha256((RBX1 / name).read_bytes()).hexdigest() == digest, name
+    assert 'pirobot/rbx1' in (RBX1 / 'README.md').read_text()
+
+
+def test_rbx1_test_map_loads_as_the_book_gives_it():
+    loaded = map_files.load_map(str(RBX1 / 'test_map.yaml'))
+    assert loaded.grid == Grid(0.05, 576, 544, (-13.8, -12.2, 0.0))
+    assert loaded.metadata.occupied_thresh == 0.9
+    pixels = np.asarray(Image.open(str(RBX1 / 'test_map.pgm')))  # PIL, another reader
+    # Its pixels are 0, 205, 254 and a few 218, 242, 255: p = (255 - v) / 255 against 0.9 and 0.196.
+    expected = np.where(pixels == 0, 100, np.where(pixels == 205, -1, 0))[::-1]
+    assert np.array_equal(loaded.values, expected)
+    assert (loaded.values == 100).sum() == (pixels == 0).sum() > 2000
+
+
+def test_rbx1_blank_map_is_all_free():
+    loaded = map_files.load_map(str(RBX1 / 'blank_map.yaml'))
+    assert loaded.grid == Grid(0.01, 600, 600, (-2.5, -2.5, 0.0))
+    assert (loaded.values == 0).all()
+
+
+# --- image_loader.cpp's rules ------------------------------------------------------------
+def _load_pixels(tmp_path, pixels, image_mode, **keys):
+    Image.fromarray(np.asarray(pixels, dtype=np.uint8), image_mode).save(str(tmp_path / 'm.png'))
+    return map_files.load_map(str(_map_yaml(tmp_path, **keys))).values[::-1]  # back to image rows
+
+
+def test_trinary_thresholds_and_negate(tmp_path):
+    # p = (255 - v) / 255: 89 -> 0.651 (> 0.65), 90 -> 0.647, 205 -> 0.19608 (not < 0.196), 206 -> 0.192.
+    grey = [[0, 89, 90, 205, 206, 254, 255]]
+    assert _load_pixels(tmp_path, grey, 'L').tolist() == [[100, 100, -1, -1, 0, 0, 0]]
+    # negate: p = v / 255: 89 -> 0.349 and 90 -> 0.353 between the thresholds, 205 -> 0.804 occupied.
+    assert _load_pixels(tmp_path, grey, 'L', negate=1).tolist() == [[0, -1, -1, 100, 100, 100, 100]]
+
+
+def test_scale_mode_maps_between_the_thresholds_linearly(tmp_path):
+    # 128: p = 127/255 = 0.49804; 1 + 98 * (0.49804 - 0.196) / (0.65 - 0.196) = 66.2 -> 66 (truncated).
+    values = _load_pixels(tmp_path, [[0, 128, 205, 254]], 'L', mode='scale')
+    assert values.tolist() == [[100, 66, 1, 0]]
+
+
+def test_raw_mode_keeps_the_byte(tmp_path):
+    assert _load_pixels(tmp_path, [[0, 37, 100, 200, 255]], 'L', mode='raw').tolist() == [[0, 37, 100, -56, -1]]
+    assert _load_pixels(tmp_path, [[0, 200]], 'L', mode='raw', negate=1).tolist() == [[-1, 55]]
+
+
+def test_colour_is_averaged_and_trinary_averages_alpha_in(tmp_path):
+    # RGB (0, 0, 255): mean 85 -> p 0.667: occupied; (255, 255, 0): mean 170 -> p 0.333: unknown.
+    assert _load_pixels(tmp_path, [[[0, 0, 255], [255, 255, 0]]], 'RGB').tolist() == [[100, -1]]
+    rgba = [[[0, 0, 0, 255], [255, 255, 255, 0], [128, 128, 128, 0], [254, 254, 254, 255]]]
+    # trinary: the mean takes alpha in: 63.75 -> p 0.75; 191.25 -> 0.25; 96 -> 0.62; 254.25 -> 0.003.
+    assert _load_pixels(tmp_path, rgba, 'RGBA').tolist() == [[100, -1, -1, 0]]
+    # scale: alpha left out of the mean, and a transparent pixel between the thresholds is unknown.
+    assert _load_pixels(tmp_path, rgba, 'RGBA', mode='scale').tolist() == [[100, 0, -1, 0]]
+
+
+def test_a_palette_image_is_read_by_its_indices_as_sdl_hands_it_over(tmp_path):
+    image = Image.new('P', (3, 1))
+    image.putpalette([255, 255, 255, 0, 0, 0] + [0] * 762)  # index 0 white, index 1 black
+    image.putdata([0, 1, 254])
+    image.save(str(tmp_path / 'm.png'))
+    # Indices 0 and 1 read as very dark: occupied, whatever the palette says; 254 free.
+    assert map_files.load_map(str(_map_yaml(tmp_path))).values[0].tolist() == [100, 100, 0]
+
+
+def test_ascii_pgm_and_a_small_maxval_scale_to_255(tmp_path):
+    (tmp_path / 'm.pgm').write_bytes(b'P2\n# a comment\n3 1\n15\n0 15 12\n')  # 12 * 255 // 15 = 204: unknown
+    assert map_files.load_map(str(_map_yaml(tmp_path, image='m.pgm'))).values.tolist() == [[100, 0, -1]]
+
+
+def test_origin_and_relative_and_absolute_image_paths(tmp_path):
+    Image.fromarray(np.zeros((2, 3), dtype=np.uint8)).save(str(tmp_path / 'm.png'))
+    loaded = map_files.load_map(str(_map_yaml(tmp_path, origin='[1.5, -2, 0.3]')))
+    assert loaded.grid == Grid(0.05, 3, 2, (1.5, -2.0, 0.3))
+    elsewhere = tmp_path / 'elsewhere'
+    elsewhere.mkdir()
+    absolute = map_files.load_map(str(_map_yaml(elsewhere, image=str(tmp_path / 'm.png'))))
+    assert np.array_equal(absolute.values, loaded.values)
+
+
+def test_mode_is_optional_and_the_default_is_trinary(tmp_path):
+    Image.fromarray(np.full((1, 1), 128, dtype=np.uint8)).save(str(tmp_path / 'm.png'))
+    assert map_files.load_map(str(_map_yaml(tmp_path))).metadata.mode == 'trinary'
+
+
+# --- errors: one line naming the file and the key ---------------------------------------------
+@pytest.mark.parametrize('key', map_files.REQUIRED_KEYS)
+def test_a_missing_key_is_named(tmp_path, key):
+    Image.fromarray(np.zeros((1, 1), dtype=np.uint8)).save(str(tmp_path / 'm.png'))
+    path = _map_yaml(tmp_path, **{key: None})
+    with pytest.raises(MapFileError) as error:
+        map_files.load_map(str(path))
+    assert str(error.value).startswith("%s: key '%s': missing" % (path, key))
+    assert error.value.key == key and '\n' not in str(error.value)
+
+
+@pytest.mark.parametrize('key, value, says', [
+    ('resolution', '-0.05', 'must be > 0'), ('resolution', '0', 'must be > 0'),
+    ('resolution', 'fine', "not 'fine'"), ('resolution', '.nan', 'finite'),
+    ('origin', '[1.0, 2.0]', '[x, y, yaw]'), ('origin', 'zero', '[x, y, yaw]'),
+    ('negate', 'maybe', 'integer'), ('occupied_thresh', 'high', 'finite number'),
+    ('free_thresh', '[0.2]', 'finite number'), ('mode', 'binary', 'trinary, scale, raw'),
+    ('image', "''", 'name of an image'),
+])
+def test_a_bad_value_is_named_with_its_key(tmp_path, key, value, says):
+    Image.fromarray(np.zeros((1, 1), dtype=np.uint8)).save(str(tmp_path / 'm.png'))
+    path = _map_yaml(tmp_path, **{key: value})
+    with pytest.raises(MapFileError, match=says) as error:
+        map_files.load_map(str(path))
+    assert str(error.value).startswith("%s: key '%s': " % (path, key))
+
+
+def test_a_missing_or_unreadable_image_is_named(tmp_path):
+    path = _map_yaml(tmp_path, image='nowhere.pgm')
+    with pytest.raises(MapFileError) as error:
+        map_files.load_map(str(path))
+    assert str(error.value) == "%s: key 'image': image file %s does not exist" % (path, tmp_path / 'nowhere.pgm')
+    (tmp_path / 'broken.png').write_bytes(b'not an image at all')
+    with pytest.raises(MapFileError, match="key 'image': cannot read image file .*broken.png"):
+        map_files.load_map(str(_map_yaml(tmp_path, image='broken.png')))
+    (tmp_path / 'short.pgm').write_bytes(b'P5\n4 4\n255\n\x00\x00')
+    with pytest.raises(MapFileError, match="key 'image': cannot read image file .*short.pgm"):
+        map_files.load_map(str(_map_yaml(tmp_path, image='short.pgm')))
+
+
+def test_a_missing_or_malformed_yaml_is_named(tmp_path):
+    with pytest.raises(MapFileError, match='^%s: cannot open the map file' % (tmp_path / 'none.yaml')):
+        map_files.load_map(str(tmp_path / 'none.yaml'))
+    (tmp_path / 'bad.yaml').write_text('image: [unclosed\n')
+    with pytest.raises(MapFileError, match='^%s: not valid YAML' % (tmp_path / 'bad.yaml')) as error:
+        map_files.load_map(str(tmp_path / 'bad.yaml'))
+    assert '\n' not in str(error.value)
+    (tmp_path / 'list.yaml').write_text('- 1\n- 2\n')
+    with pytest.raises(MapFileError, match='a mapping of the keys image, resolution'):
+        map_files.load_map(str(tmp_path / 'list.yaml'))
+
+
+def test_a_map_that_cannot_be_written_is_named(tmp_path):
+    with pytest.raises(MapFileError, match="no_such_folder/m.pgm: couldn't save map file"):
+        map_files.save_map(Grid(0.05, 1, 1), np.zeros((1, 1), np.int8),
+                           SaverConfig(mapname=str(tmp_path / 'no_such_folder' / 'm')))
+
+
+@pytest.mark.parametrize('options, message', [
+    (dict(threshold_occupied=0), 'threshold_occupied must be between 1 and 100'),
+    (dict(threshold_occupied=101), 'threshold_occupied must be between 1 and 100'),
+    (dict(threshold_free=-1), 'threshold_free must be between 0 and 100'),
+    (dict(threshold_occupied=30, threshold_free=30), 'threshold_free must be smaller than threshold_occupied'),
+])
+def test_saver_options_are_checked_as_map_saver_checks_them(options, message):
+    with pytest.raises(ValueError, match='^%s$' % message):
+        SaverConfig(**options)
+
+
+def test_the_shipped_maps_name_their_image_by_its_bare_name_so_they_move_with_their_folder(tmp_path):
+    for name in SHIPPED:
+        shutil.copy(str(REPO / 'maps' / (name + '.yaml')), str(tmp_path))
+        shutil.copy(str(REPO / 'maps' / (name + '.pgm')), str(tmp_path))
+        assert (REPO / 'maps' / (name + '.yaml')).read_text().startswith('image: %s.pgm\n' % name)
+        assert map_files.load_map(str(tmp_path / (name + '.yaml'))).values.size > 0
+
+
+# --- the command lines and messages of map_saver and map_server (no master needed) ------------
+@pytest.mark.parametrize('argv, expected', [
+    ([], SaverConfig()),
+    (['-f', '/home/learner/map'], SaverConfig(mapname='/home/learner/map')),
+    (['--occ', '90', '--free', '10', '-f', 'x'], SaverConfig(90, 10, 'x')),
+    (['--free', 'lots'], SaverConfig(threshold_free=0)),  # atoi: no digits read 0, as in C
+    (['--occ', '70%'], SaverConfig(threshold_occupied=70)),
+])
+def test_map_saver_parses_its_options_as_its_main_does(argv, expected):
+    from map_server.saver import parse_arguments
+    assert parse_arguments(argv) == expected
+
+
+@pytest.mark.parametrize('argv, status, message', [
+    (['-h'], 0, 'Usage: \n  map_saver -h\n'), (['-f'], 1, 'Usage: '), (['--occ'], 1, 'Usage: '),
+    (['--map', 'x'], 1, 'Usage: '), (['extra'], 1, 'Usage: '),
+    (['--occ', '0'], 1, 'threshold_occupied must be between 1 and 100'),
+    (['--free', '101'], 1, 'threshold_free must be between 0 and 100'),
+    (['--occ', '20'], 1, 'threshold_free must be smaller than threshold_occupied'),
+])
+def test_map_saver_refuses_bad_use_with_its_messages_and_statuses(argv, status, message):
+    from map_server.saver import UsageError, parse_arguments
+    with pytest.raises(UsageError) as error:
+        parse_arguments(argv)
+    assert error.value.status == status and str(error.value).startswith(message)
+
+
+def test_map_messages_carry_the_grid_and_its_values_both_ways():
+    from io import BytesIO
+
+    from nav_msgs.msg import OccupancyGrid
+    import rospy
+    from tb3_common.ros.map_messages import grid_of_message, occupancy_grid
+    grid = Grid(0.05, 4, 3, (-1.0, 2.0, 0.5))
+    values = np.arange(12, dtype=np.int8).reshape(3, 4) - 1
+    message = occupancy_grid(grid, values, 'map', rospy.Time(7, 5))
+    assert message.info.width == 4 and message.info.height == 3 and message.data[:2] == [-1, 0]
+    assert message.info.origin.orientation.z == pytest.approx(math.sin(0.25))
+    buffer = BytesIO()
+    message.serialize(buffer)
+    received = OccupancyGrid().deserialize(buffer.getvalue())
+    back, back_values, orientation = grid_of_message(received)
+    assert back.width == 4 and back.height == 3 and back.origin[:2] == (-1.0, 2.0)
+    assert back.origin[2] == pytest.approx(0.5) and back.resolution == pytest.approx(0.05)
+    assert np.array_equal(back_values, values) and received.header.frame_id == 'map'

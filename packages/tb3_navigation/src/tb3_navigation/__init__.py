@@ -1,0 +1,1 @@
+"""Mapping and navigation algorithms (numpy, scipy; no ROS); their nodes are the packages amcl, move_base, gmapping, explore_lite."""

@@ -1,0 +1,337 @@
+"""The local controller: dwa_local_planner as TurtleBot3's move_base runs it. No ROS here.
+
+Each cycle (controller_frequency, 10 Hz) the controller samples velocities
+(v, w) in the dynamic window: what the accelerations allow within one period
+(acc_lim_x 2.5 m/s^2 and acc_lim_theta 3.2 rad/s^2 over 0.1 s: +-0.25 m/s,
++-0.32 rad/s around the robot's velocity), vx_samples x vth_samples of them
+(20 x 40) with 0 added where the window spans it. A sample must move at
+least min_vel_trans or turn at least min_vel_theta and not exceed
+max_vel_trans, and must not flip the direction the robot has just been
+moving or turning in (the oscillation flags, reset after
+oscillation_reset_dist or oscillation_reset_angle). Each is scored by DWA's
+critics (tb3_navigation.trajectory_scoring); the cheapest wins (the first
+sampled among equals); none: the robot is told to stop and the call fails.
+
+Within xy_goal_tolerance of the goal (latched if latch_xy_goal_tolerance)
+the stop-and-rotate controller takes over: slow down with the accelerations
+until stopped (trans_stopped_vel, theta_stopped_vel 0.1), then turn in place
+towards the goal's yaw (between min_vel_theta and max_vel_theta, slow enough
+to stop in time) until within yaw_goal_tolerance, each command checked
+against the costmap first. One deviation: DWA raises an in-place turn to
+min_vel_theta after its acceleration check (0 -> 1.37 rad/s at once on the
+Burger); here the acceleration window comes last, so every command is
+reachable from the current velocity in one period.
+
+stop_time_buffer is read and ignored, as dwa_local_planner ignores it.
+Poses, plans and the costmap are in one frame (the local costmap's, odom);
+velocities in the robot's. Every command is finite and within the limits.
+"""
+import math
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from tb3_common.pose2d import normalize_angle
+from tb3_navigation.trajectory_scoring import GOAL_ZONE, TrajectoryScorer, velocity_samples
+
+EPSILON = 1e-4  # m/s, rad/s: SimpleTrajectoryGenerator's slack on the velocity limits
+#: Where the controller aims, as a share of xy_goal_tolerance and yaw_goal_tolerance. DWA stops the
+#: moment it is within them; at 10 Hz, 0.11 m/s and 1.37 rad/s (the least speeds it drives at) that
+#: left the Burger 0.038-0.045 m and up to 0.169 rad off with a perfect pose, so a localization
+#: error of 1-2 cm put the true pose outside. Here the approach ends within ARRIVAL of the distance
+#: tolerance, or within PASSED of it once the robot drives away from the goal again (it went by:
+#: turning back would only oscillate), and the goal counts as reached only once the turn in place
+#: has brought the heading within ARRIVAL of the yaw tolerance. Within the tolerance itself it also
+#: ends after STALLED periods (5 s, twice a half turn in place) without coming 1 mm nearer, where DWA
+#: would have stopped at once: near a wall the sampled trajectories left only a step forward and one
+#: back, and the Burger stood 4.8 cm from the goal until move_base's oscillation_timeout. (After 1 s
+#: it ended approaches still turning towards the goal, 5 cm off.)
+ARRIVAL = 0.3
+PASSED = 0.5
+STALLED = 50
+
+
+@dataclass(frozen=True)
+class DwaConfig:
+    """dwa_local_planner's parameters: dwa_local_planner_params_burger.yaml (noetic), and
+    dwa_local_planner's defaults for those it does not set."""
+    max_vel_x: float = 0.22  # m/s
+    min_vel_x: float = -0.22  # m/s: negative drives backwards (move_forward_only: 0)
+    max_vel_y: float = 0.0  # a differential base: 0
+    min_vel_y: float = 0.0  # a differential base: 0
+    max_vel_trans: float = 0.22  # m/s
+    min_vel_trans: float = 0.11  # m/s: slower drives must turn at least min_vel_theta
+    max_vel_theta: float = 2.75  # rad/s
+    min_vel_theta: float = 1.37  # rad/s: the slowest turn in place
+    acc_lim_x: float = 2.5  # m/s^2
+    acc_lim_y: float = 0.0  # a differential base: 0
+    acc_lim_theta: float = 3.2  # rad/s^2
+    xy_goal_tolerance: float = 0.05  # m: the goal is reached this near (the controller aims at 0.3 of it)
+    yaw_goal_tolerance: float = 0.17  # rad: and turned this near (aims at 0.3 of it)
+    latch_xy_goal_tolerance: bool = False  # true: once near enough, only turn
+    sim_time: float = 1.5  # s each sampled trajectory is simulated
+    sim_granularity: float = 0.025  # m between checks along a trajectory
+    angular_sim_granularity: float = 0.1  # rad between checks along a turn
+    vx_samples: int = 20  # speeds sampled
+    vy_samples: int = 0  # a differential base: 0
+    vth_samples: int = 40  # turn rates sampled
+    controller_frequency: float = 10.0  # Hz: the window of reachable speeds is one period of the accelerations
+    path_distance_bias: float = 32.0  # weight of staying on the global plan
+    goal_distance_bias: float = 20.0  # weight of getting to the local goal
+    occdist_scale: float = 0.02  # weight of keeping off obstacles
+    obstacle_clearance: float = 0.12  # m (ours): trajectories keep this far from obstacles whenever one can
+    forward_point_distance: float = 0.325  # m: the point ahead scored too
+    stop_time_buffer: float = 0.2  # s: a trajectory must stop this long before an obstacle
+    scaling_speed: float = 0.25  # m/s: above it the footprint is scaled up
+    max_scaling_factor: float = 0.2  # up to 1 + this
+    oscillation_reset_dist: float = 0.05  # m: moving this far resets the oscillation flags
+    oscillation_reset_angle: float = 0.2  # rad: turning this far resets them too
+    trans_stopped_vel: float = 0.1  # m/s: slower counts as stopped
+    theta_stopped_vel: float = 0.1  # rad/s: slower counts as stopped
+
+    def __post_init__(self):
+        for field in fields(self):
+            value = getattr(self, field.name)
+            if field.type is bool:
+                continue
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ValueError('%s must be a finite number, not %r' % (field.name, value))
+            if field.name not in ('min_vel_x', 'min_vel_y') and value < 0:
+                raise ValueError('%s must be >= 0, not %r' % (field.name, value))
+        for name in ('max_vel_y', 'min_vel_y', 'acc_lim_y', 'vy_samples'):
+            if getattr(self, name) != 0:
+                raise ValueError('%s must be 0 (this controller drives a differential base), not %r'
+                                 % (name, getattr(self, name)))
+        if self.min_vel_x > self.max_vel_x:
+            raise ValueError('min_vel_x (%r) must not exceed max_vel_x (%r)' % (self.min_vel_x, self.max_vel_x))
+        for name in ('controller_frequency', 'sim_time', 'sim_granularity', 'angular_sim_granularity',
+                     'max_vel_trans', 'max_vel_theta'):
+            if not getattr(self, name) > 0:
+                raise ValueError('%s must be > 0, not %r' % (name, getattr(self, name)))
+
+    @property
+    def sim_period(self):
+        return 1.0 / self.controller_frequency
+
+
+#: dwa_local_planner_params_<model>.yaml where they differ from the Burger's.
+MODELS = {'burger': {},
+          'waffle': dict(max_vel_x=0.26, min_vel_x=-0.26, max_vel_trans=0.26, min_vel_trans=0.13,
+                         max_vel_theta=1.82, min_vel_theta=0.9, sim_time=2.0)}
+MODELS['waffle_pi'] = MODELS['waffle']
+
+
+def dwa_config(model='burger', move_forward_only=False, **overrides):
+    """TurtleBot3's DwaConfig for `model`; move_forward_only sets min_vel_x 0, as its move_base.launch."""
+    if model not in MODELS:
+        raise ValueError('model must be one of %s, not %r' % (', '.join(sorted(MODELS)), model))
+    values = dict(MODELS[model], **({'min_vel_x': 0.0} if move_forward_only else {}))
+    values.update(overrides)
+    return DwaConfig(**values)
+
+
+@dataclass(frozen=True)
+class Command:
+    """A velocity command (v m/s, w rad/s), whether the controller found one (ok), the
+    trajectory it follows (n, 3) (the local plan) and, when not ok, why."""
+    v: float
+    w: float
+    ok: bool
+    trajectory: np.ndarray = None
+    reason: str = ''
+
+
+class DwaController(object):
+    """DWA over `costmap` (a tb3_navigation.costmap.Costmap, the local one, updated by its owner)."""
+
+    def __init__(self, costmap, config=DwaConfig()):
+        self.costmap = costmap
+        self.config = config
+        self.scorer = TrajectoryScorer(costmap, config)
+        self._rotating = False  # turning to the goal's yaw (LatchedStopRotateController's rotating_to_goal_)
+        self.reset()
+
+    def reset(self):
+        """A new global plan: forget the goal latch and the oscillation flags (DWAPlannerROS::setPlan).
+        A turn to the goal's yaw goes on (resetLatching keeps rotating_to_goal_): move_base plans anew
+        at 5 Hz, and forgetting it braked every other period, turning at a quarter of the speed."""
+        self._latched = False
+        self._flags = {}
+        self._stationary = None
+
+    def _same_goal(self, goal):
+        # In the local frame the goal moves with every correction of the localization (map -> odom):
+        # a goal that moved less than the tolerance is the same goal.
+        last = getattr(self, '_arrival_goal', None)
+        return last is not None and math.hypot(goal[0] - last[0], goal[1] - last[1]) <= self.config.xy_goal_tolerance
+
+    def _arrive(self, pose, goal):
+        """Whether the approach is over (once over, it stays so for this goal, across new plans): within
+        ARRIVAL of xy_goal_tolerance, within PASSED of it and past the closest point of the way in, or
+        within it and STALLED periods (calls) without coming nearer."""
+        if not self._same_goal(goal):
+            self._arrival_goal, self._arrived, self._closest = (goal[0], goal[1]), False, math.inf
+            self._rotating, self._stalled = False, 0
+        distance = math.hypot(goal[0] - pose[0], goal[1] - pose[1])
+        tolerance = self.config.xy_goal_tolerance
+        self._stalled = 0 if distance < self._closest - 1e-3 else self._stalled + 1
+        if distance <= ARRIVAL * tolerance or (distance <= PASSED * tolerance and distance > self._closest + 1e-3) \
+                or (distance <= tolerance and self._stalled >= STALLED):
+            self._arrived = True
+        self._closest = min(self._closest, distance)
+        return self._arrived
+
+    # --- the goal ---------------------------------------------------------------------------
+
+    def is_position_reached(self, pose, plan):
+        """Within xy_goal_tolerance, the approach over (see _arrive); or latched."""
+        config = self.config
+        goal = plan[-1]
+        distance = math.hypot(goal[0] - pose[0], goal[1] - pose[1])
+        arrived = self._same_goal(goal) and self._arrived
+        if (config.latch_xy_goal_tolerance and self._latched) or \
+                (distance <= config.xy_goal_tolerance and (arrived or distance <= ARRIVAL * config.xy_goal_tolerance)):
+            self._latched = True
+            return True
+        return False
+
+    def is_goal_reached(self, pose, velocity, plan):
+        """At the goal's position and yaw, and stopped (LatchedStopRotateController::isGoalReached)."""
+        config = self.config
+        plan = np.asarray(plan, dtype=float)
+        if not len(plan) or not self.is_position_reached(pose, plan):
+            return False
+        return (abs(normalize_angle(plan[-1][2] - pose[2])) <= ARRIVAL * config.yaw_goal_tolerance and
+                abs(velocity[0]) <= config.trans_stopped_vel and abs(velocity[1]) <= config.theta_stopped_vel)
+
+    # --- the command ------------------------------------------------------------------------
+
+    def compute(self, pose, velocity, plan):
+        """The Command for the robot at `pose` (x, y, yaw) moving at `velocity` (v, w) to
+        follow `plan` [(x, y, yaw), ...] to its last pose."""
+        pose = np.asarray(pose, dtype=float)
+        velocity = np.asarray(velocity, dtype=float)
+        plan = np.asarray(plan, dtype=float).reshape(-1, 3)
+        if not (np.all(np.isfinite(pose)) and np.all(np.isfinite(velocity)) and np.all(np.isfinite(plan))):
+            return Command(0.0, 0.0, False, reason='a non-finite pose, velocity or plan')
+        local = self._local_plan(pose, plan)
+        if not len(local):
+            return Command(0.0, 0.0, False, reason='no point of the plan within the local costmap')
+        self._arrive(pose, plan[-1])
+        if self.is_position_reached(pose, plan):
+            command = self._stop_and_rotate(pose, velocity, local, plan[-1][2])
+        else:
+            self._rotating = False
+            command = self._dwa(pose, velocity, local, plan[-1])
+        return self._safe(command)
+
+    def _local_plan(self, pose, plan):
+        """transformGlobalPlan: from the first pose within half the costmap's size of the
+        robot, up to the first beyond it."""
+        grid = self.costmap.grid
+        threshold = max(grid.width, grid.height) * grid.resolution / 2.0
+        near = np.hypot(plan[:, 0] - pose[0], plan[:, 1] - pose[1]) <= threshold
+        if not near.any():
+            return plan[:0]
+        first = int(np.argmax(near))
+        beyond = np.flatnonzero(~near[first:])
+        return plan[first:first + (beyond[0] if len(beyond) else len(plan))]
+
+    def _safe(self, command):
+        config = self.config
+        v, w = command.v, command.w
+        if not (math.isfinite(v) and math.isfinite(w)):
+            return Command(0.0, 0.0, False, reason='a non-finite command')
+        v = min(max(v, config.min_vel_x), config.max_vel_x, config.max_vel_trans)
+        v = max(v, -config.max_vel_trans)
+        w = min(max(w, -config.max_vel_theta), config.max_vel_theta)
+        return replace(command, v=float(v), w=float(w))
+
+    def _stop_and_rotate(self, pose, velocity, local, goal_yaw):
+        config = self.config
+        period = config.sim_period
+        difference = normalize_angle(goal_yaw - pose[2])
+        if abs(difference) <= ARRIVAL * config.yaw_goal_tolerance:
+            self._rotating = False
+            # Brake as hard as acc_lim_theta allows (a stop at once would ask for more).
+            w = math.copysign(max(0.0, abs(velocity[1]) - config.acc_lim_theta * period), velocity[1])
+            return Command(0.0, w, True, pose[None, :])
+        stopped = abs(velocity[0]) <= config.trans_stopped_vel and abs(velocity[1]) <= config.theta_stopped_vel
+        if not self._rotating and not stopped:
+            v = math.copysign(max(0.0, abs(velocity[0]) - config.acc_lim_x * period), velocity[0])
+            w = math.copysign(max(0.0, abs(velocity[1]) - config.acc_lim_theta * period), velocity[1])
+            what = 'stopping'
+        else:
+            self._rotating = True
+            speed = min(config.max_vel_theta, max(config.min_vel_theta, abs(difference)))
+            speed = min(speed, math.sqrt(2.0 * config.acc_lim_theta * abs(difference)))
+            speed = min(config.max_vel_theta, max(config.min_vel_theta, speed))
+            # The last step turns just what is left: a full period at min_vel_theta would turn
+            # 0.137 rad, most of the yaw tolerance, past the goal's yaw.
+            speed = min(speed, abs(difference) / period)
+            reach = config.acc_lim_theta * period
+            v, w = 0.0, min(max(math.copysign(speed, difference), velocity[1] - reach), velocity[1] + reach)
+            what = 'rotating'
+        maps = self.scorer.maps(pose, local)
+        costs, trajectories = self.scorer.score(pose, np.array([[v, w]]), maps, check_all=True)
+        if costs[0] < 0:
+            return Command(0.0, 0.0, False, reason='%s would collide' % what)
+        return Command(v, w, True, trajectories[0])
+
+    def _dwa(self, pose, velocity, local, goal):
+        config = self.config
+        period = config.sim_period
+        low_v = max(config.min_vel_x, velocity[0] - config.acc_lim_x * period)
+        high_v = min(config.max_vel_x, velocity[0] + config.acc_lim_x * period)
+        low_w = max(-config.max_vel_theta, velocity[1] - config.acc_lim_theta * period)
+        high_w = min(config.max_vel_theta, velocity[1] + config.acc_lim_theta * period)
+        vs = velocity_samples(min(low_v, high_v), high_v, config.vx_samples)
+        ws = velocity_samples(min(low_w, high_w), high_w, config.vth_samples)
+        samples = np.stack(np.meshgrid(vs, ws, indexing='ij'), axis=-1).reshape(-1, 2)
+        moving = (np.abs(samples[:, 0]) + EPSILON >= config.min_vel_trans) | \
+                 (np.abs(samples[:, 1]) + EPSILON >= config.min_vel_theta)
+        samples = samples[moving & (np.abs(samples[:, 0]) - EPSILON <= config.max_vel_trans)]
+        samples = samples[[self._allowed(v, w) for v, w in samples]] if self._flags else samples
+        if not len(samples):
+            return Command(0.0, 0.0, False, reason='no velocity in the dynamic window')
+        far = math.hypot(goal[0] - pose[0], goal[1] - pose[1]) > GOAL_ZONE
+        costs, trajectories = self.scorer.score(pose, samples, self.scorer.maps(pose, local), clearance=far)
+        valid = np.flatnonzero(costs >= 0)
+        if not len(valid):
+            return Command(0.0, 0.0, False, reason='every trajectory collides or leaves the plan')
+        best = valid[np.argmin(costs[valid])]
+        v, w = samples[best]
+        self._update_flags(pose, v, w)
+        return Command(float(v), float(w), True, trajectories[best])
+
+    # --- oscillation flags (base_local_planner's OscillationCostFunction) ------------------
+
+    def _allowed(self, v, w):
+        flags = self._flags
+        return not ((flags.get('forward_only') and v < 0) or (flags.get('backward_only') and v > 0) or
+                    (flags.get('left_only') and w < 0) or (flags.get('right_only') and w > 0))
+
+    def _update_flags(self, pose, v, w):
+        flags, config = self._flags, self.config
+        set_now = False
+        for value, positive, negative, positive_only, negative_only, applies in (
+                (v, 'forward', 'backward', 'forward_only', 'backward_only', True),
+                (w, 'left', 'right', 'left_only', 'right_only', abs(v) <= config.min_vel_trans)):
+            if not applies:
+                continue
+            if value < 0:
+                if flags.get(positive):
+                    flags[negative_only] = set_now = True
+                flags[positive], flags[negative] = False, True
+            elif value > 0:
+                if flags.get(negative):
+                    flags[positive_only] = set_now = True
+                flags[negative], flags[positive] = False, True
+        if set_now:
+            self._stationary = np.array(pose, dtype=float)
+        if any(flags.get(name) for name in ('forward_only', 'backward_only', 'left_only', 'right_only')):
+            moved = np.hypot(*(pose[:2] - self._stationary[:2])) if self._stationary is not None else math.inf
+            turned = abs(normalize_angle(pose[2] - self._stationary[2])) if self._stationary is not None else 0.0
+            if moved > config.oscillation_reset_dist or turned > config.oscillation_reset_angle:
+                flags.clear()
+

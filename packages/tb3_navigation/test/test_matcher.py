@@ -1,0 +1,127 @@
+"""tb3_navigation.matcher: scans put back where they were taken on maps of known rooms."""
+import math
+
+import numpy as np
+import pytest
+
+from tb3_navigation import matcher
+from tb3_navigation.occupancy import OccupancyGrid
+from tb3_common.pose2d import compose
+from tb3_navigation.scan import Scan
+from tb3_sim_nav import world_map
+from tb3_sim_nav.world_file import Obstacle
+
+SIGMA = 0.05  # turtlebot3_slam's sigma
+RANGE_MIN, RANGE_MAX, MAX_URANGE = 0.12, 3.5, 3.0
+SENSOR = (-0.032, 0.0, 0.0)  # base_scan on the Burger
+
+
+def box(x, y, size_x, size_y, yaw=0.0):
+    return Obstacle(kind='box', size=(size_x, size_y, 0.4), position=(x, y, 0.2), yaw=yaw, color=None)
+
+
+def cylinder(x, y, radius):
+    return Obstacle(kind='cylinder', size=(radius, 0.4), position=(x, y, 0.2), yaw=0.0, color=None)
+
+
+#: A room 4 x 3 m with a pillar and a box in it, walls 0.1 m thick.
+ROOM = [box(0.0, 1.55, 4.2, 0.1), box(0.0, -1.55, 4.2, 0.1), box(2.05, 0.0, 0.1, 3.0), box(-2.05, 0.0, 0.1, 3.0),
+        cylinder(0.8, 0.6, 0.15), box(-1.0, -0.8, 0.4, 0.3, yaw=0.5)]
+#: A corridor 1 m wide and 12 m long: from its middle its ends are out of range.
+CORRIDOR = [box(0.0, 0.55, 12.0, 0.1), box(0.0, -0.55, 12.0, 0.1)]
+
+
+def ray_cast(obstacles, sensor, rng, beams=360, noise=0.01):
+    """A scan of `obstacles` from `sensor` (x, y, yaw): sphere tracing on the signed distance."""
+    angles = sensor[2] + np.arange(beams) * 2 * math.pi / beams
+    directions = np.stack((np.cos(angles), np.sin(angles)), axis=-1)
+    travelled = np.zeros(beams)
+    for _ in range(200):
+        distance = world_map.signed_distance(obstacles, np.asarray(sensor[:2]) + travelled[:, None] * directions)
+        travelled = np.where(distance > 1e-4, travelled + distance, travelled)
+    ranges = np.where(travelled < RANGE_MAX, travelled + rng.normal(0.0, noise, beams), math.inf)
+    return Scan(0.0, 2 * math.pi / beams, ranges, RANGE_MIN, RANGE_MAX)
+
+
+def field_of(obstacles, poses, rng):
+    """The likelihood field of the map made of scans taken at the base's `poses`."""
+    grid_map = OccupancyGrid.around(0.05, -3.0, -3.0, 7.0, 3.0)
+    for pose in poses:
+        sensor = tuple(compose(pose, SENSOR))
+        grid_map.add_scan(sensor, ray_cast(obstacles, sensor, rng), MAX_URANGE, RANGE_MAX)
+    return matcher.WallField(grid_map.grid, grid_map.occupied(), SIGMA, grid_map.hit_means())
+
+
+def points_at(obstacles, pose, rng):
+    """A scan taken with the base at `pose`, as end points in the base frame."""
+    return ray_cast(obstacles, tuple(compose(pose, SENSOR)), rng).hit_points(SENSOR, max_range=MAX_URANGE)
+
+
+@pytest.fixture(scope='module')
+def room():
+    rng = np.random.default_rng(3)
+    return field_of(ROOM, [(-1.0, 0.5, 0.0), (1.0, -0.6, 2.0), (0.0, 0.0, -1.0)], rng)
+
+
+def error(pose, truth):
+    return math.hypot(pose[0] - truth[0], pose[1] - truth[1]), abs(pose[2] - truth[2])
+
+
+def test_the_score_counts_the_points_on_walls(room):
+    truth = (0.3, -0.2, 0.4)
+    points = points_at(ROOM, truth, np.random.default_rng(4))
+    assert room.score(matcher.place(truth, points)) > 0.9 * len(points)
+    assert room.score(matcher.place((0.6, 0.1, 0.4), points)) < 0.2 * len(points)
+
+
+@pytest.mark.parametrize('offset', [(0.03, -0.02, 0.02), (-0.04, 0.01, -0.03), (0.0, 0.0, 0.04)])
+def test_refine_puts_a_scan_back_where_it_was_taken(room, offset):
+    truth = (0.3, -0.2, 0.4)
+    points = points_at(ROOM, truth, np.random.default_rng(5))
+    pose, score = matcher.refine(room, points, np.add(truth, offset), iterations=10)
+    distance, turn = error(pose, truth)
+    assert distance < 0.005 and turn < math.radians(0.2)
+    assert score > 0.9 * len(points)
+
+
+def test_the_search_lands_on_the_node_of_its_grid_at_the_truth(room):
+    truth = (-0.5, 0.4, -0.7)
+    points = points_at(ROOM, truth, np.random.default_rng(6))
+    prior = np.add(truth, (0.1, -0.05, 0.1))  # a node of the search's grid: 2 steps, 1 step, 2 steps
+    start, score = matcher.search(room, points, prior, 0.1, 0.1, 0.05, 0.05)
+    distance, turn = error(start, truth)
+    assert distance < 1e-9 and turn < 1e-9
+    assert score > 2 * room.score(matcher.place(prior, points))
+
+
+def test_the_search_stays_within_its_reach(room):
+    truth = (-0.5, 0.4, -0.7)
+    points = points_at(ROOM, truth, np.random.default_rng(6))
+    prior = np.add(truth, (0.2, 0.0, 0.0))
+    start, _ = matcher.search(room, points, prior, 0.1, 0.1, 0.05, 0.05)
+    assert start[0] == pytest.approx(prior[0] - 0.1)  # as near the truth as it may go
+
+
+def test_along_a_corridor_the_prior_holds_the_pose():
+    """Nothing in range tells where along the corridor the robot is: the prior's
+    pull keeps that, while the walls correct the rest."""
+    rng = np.random.default_rng(7)
+    corridor = field_of(CORRIDOR, [(x, 0.0, 0.0) for x in np.arange(-2.0, 6.1, 1.0)], rng)
+    truth = (2.0, 0.1, 0.05)
+    points = points_at(CORRIDOR, truth, rng)
+    prior = (2.04, 0.07, 0.08)
+    pose, _ = matcher.refine(corridor, points, prior, iterations=10, prior=prior, prior_weight=20.0)
+    assert pose[0] == pytest.approx(prior[0], abs=0.002)  # along: kept
+    assert pose[1] == pytest.approx(truth[1], abs=0.005)  # across: corrected
+    assert pose[2] == pytest.approx(truth[2], abs=math.radians(0.3))
+
+
+def test_an_empty_map_leaves_the_prior_alone():
+    empty = OccupancyGrid.around(0.05, -3.0, -3.0, 3.0, 3.0)
+    field = matcher.WallField(empty.grid, empty.occupied(), SIGMA, empty.hit_means())
+    points = points_at(ROOM, (0.0, 0.0, 0.0), np.random.default_rng(8))
+    prior = (0.1, 0.2, 0.3)
+    assert field.empty
+    assert matcher.search(field, points, prior, 0.1, 0.1, 0.05, 0.05) == (prior, 0.0)
+    pose, score = matcher.refine(field, points, prior, iterations=5)
+    assert pose == pytest.approx(prior) and score == 0.0

@@ -1,0 +1,284 @@
+"""tb3_navigation.slam on recorded drives of the simulated Burger (realistic profile: drifting odometry).
+
+The SLAM sees scans and odometry only; the true poses and the world file judge it.
+"""
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from tb3_common.pose2d import IDENTITY, compose, normalize_angle, relative
+from tb3_navigation.scan import Scan
+from tb3_navigation.slam import Slam, SlamConfig, SlamConfigError
+from tb3_harness.map_quality import measure
+from tb3_sim_nav.world_file import load_world
+
+from tb3_harness import ROOT as REPO
+from tb3_harness.drives import HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, path_length, record_drive
+
+#: turtlebot3_slam's gmapping_params.yaml (ROBOTIS-GIT/turtlebot3, noetic), the values we share.
+TURTLEBOT3_GMAPPING = dict(map_update_interval=2.0, maxUrange=3.0, sigma=0.05, lstep=0.05, astep=0.05,
+                           iterations=5, lskip=0, minimumScore=50, linearUpdate=1.0, angularUpdate=0.2,
+                           temporalUpdate=0.5, xmin=-10.0, ymin=-10.0, xmax=10.0, ymax=10.0, delta=0.05)
+
+
+def scans_of(drive, ranges=None):
+    ranges = drive.ranges if ranges is None else ranges
+    return [Scan(drive.angle_min, drive.angle_increment, r, drive.range_min, drive.range_max) for r in ranges]
+
+
+def run(drive, indices=None, odom=None, ranges=None, slam=None):
+    """Feed `drive`'s scans (those of `indices`, in that order, stamped 0.2 s apart) to a Slam;
+    returns it, the poses it gave and whether each scan was taken for a jump."""
+    slam = slam or Slam()
+    indices = range(len(drive.times)) if indices is None else indices
+    odom = drive.odom if odom is None else odom
+    scans = scans_of(drive, ranges)
+    poses, jumps = [], []
+    for step, index in enumerate(indices):
+        poses.append(slam.update(0.2 * step, odom[index], scans[index], drive.scan_pose))
+        jumps.append(slam.jumped)
+    return slam, np.array(poses), np.array(jumps)
+
+
+def errors(poses, truth):
+    """Distance (n,) and heading error (n,) of poses (n, 3) from the truth (n, 3)."""
+    return np.hypot(*(poses[:, :2] - truth[:, :2]).T), np.abs(normalize_angle(poses[:, 2] - truth[:, 2]))
+
+
+def obstacles(world):
+    return load_world(world, str(REPO / 'worlds')).obstacles
+
+
+def quality(slam, world, start):
+    """tb3_harness.map_quality's measures of the SLAM's map in `world`'s obstacles, from `start` (x, y)."""
+    return measure(slam.grid, slam.map_values(), world, start[:2])
+
+
+@pytest.fixture(scope='module')
+def loop():
+    """turtlebot3_world's loop of 13.6 m around the pillars; its odometry ends 18 cm and 2.8 degrees off."""
+    return record_drive('turtlebot3_world', WORLD_LOOP_START, WORLD_LOOP)
+
+
+@pytest.fixture(scope='module')
+def loop_slam(loop):
+    return run(loop)
+
+
+@pytest.fixture(scope='module')
+def world():
+    return obstacles('turtlebot3_world')
+
+
+def test_the_loop_ends_within_5_cm_and_2_degrees_while_odometry_does_not(loop, loop_slam):
+    _, poses, _ = loop_slam
+    distance, turn = errors(poses[-1:], loop.truth[-1:])
+    odom_distance, odom_turn = errors(loop.odom[-1:], loop.truth[-1:])
+    assert path_length(loop.truth) > 13.0
+    assert odom_distance[0] > 0.10  # what the SLAM has to correct (measured: 0.18 m, 2.8 degrees)
+    assert distance[0] < 0.05 and turn[0] < math.radians(2.0)  # measured: 0.2 cm, 0.00 degree
+    assert distance[0] < odom_distance[0] / 5
+
+
+def test_the_pose_stays_within_5_cm_and_2_degrees_all_the_way(loop, loop_slam):
+    """Not only at the end: every scan's pose (measured: at most 0.5 cm and 0.55 degree, the
+    degrees while turning, when the simulated lidar lags its base by one physics step)."""
+    _, poses, _ = loop_slam
+    distance, turn = errors(poses, loop.truth)
+    assert distance.max() < 0.05 and turn.max() < math.radians(2.0)
+
+
+def test_at_start_map_is_odom(loop):
+    slam = Slam()
+    first = slam.update(0.0, loop.odom[0], scans_of(loop)[0], loop.scan_pose)
+    assert slam.map_to_odom == IDENTITY
+    assert first == pytest.approx(tuple(loop.odom[0]))
+
+
+def test_map_to_odom_maps_odometry_onto_the_pose(loop, loop_slam):
+    slam, poses, _ = loop_slam
+    assert compose(slam.map_to_odom, loop.odom[-1]) == pytest.approx(poses[-1], abs=1e-9)
+
+
+def test_the_maps_walls_lie_on_the_worlds_walls_thin_and_single(loop_slam, world):
+    """The issue's goals (tb3_harness.map_quality): >= 95 % of the occupied cells within
+    0.10 m of a surface, >= 80 % of the surface facing the free space with an occupied cell
+    within 0.10 m, walls a median 2 cells thick or less; and, for no doubled or smeared wall,
+    under 0.5 % of the surface doubled and under 5 % thicker than 2 cells. Measured: 100 %,
+    100 %, 1 cell, 0 % doubled, 0.6 % thicker."""
+    slam, _, _ = loop_slam
+    measured = quality(slam, world, WORLD_LOOP_START)
+    assert not measured.failures(), measured.summary()
+    assert measured.occupied_cells > 500 and measured.surface_points > 1000
+    assert measured.doubled_wall_share < 0.005 and measured.thick_wall_share < 0.05, measured.summary()
+
+
+def test_the_measures_see_what_odometry_alone_draws(loop, world):
+    """The bounds above can fail: the map drawn at the odometry's poses (matches never
+    accepted) meets the issue's goals (96 % near a surface) but doubles 1.5 % of the
+    surface and makes 14 % of it thicker than 2 cells."""
+    slam, _, _ = run(loop, slam=Slam(SlamConfig(minimumScore=1e9)))
+    measured = quality(slam, world, WORLD_LOOP_START)
+    assert measured.doubled_wall_share > 0.005 and measured.thick_wall_share > 0.05, measured.summary()
+
+
+def test_the_same_input_gives_the_same_map(loop, loop_slam):
+    first, poses, _ = loop_slam
+    second, again, _ = run(loop)
+    assert np.array_equal(first.map_values(), second.map_values())
+    assert np.array_equal(poses, again)
+
+
+def test_nan_and_infinite_beams_are_skipped_one_by_one(loop, world):
+    """A third of every scan's beams turned to NaN, +inf or -inf: the pose and the map
+    are as good as with the whole scans."""
+    rng = np.random.default_rng(12)
+    ranges = loop.ranges.copy()
+    spoilt = rng.random(ranges.shape) < 1 / 3
+    ranges[spoilt] = rng.choice([math.nan, math.inf, -math.inf], size=np.count_nonzero(spoilt))
+    slam, poses, _ = run(loop, ranges=ranges)
+    distance, turn = errors(poses, loop.truth)
+    assert distance.max() < 0.05 and turn.max() < math.radians(2.0)
+    assert quality(slam, world, WORLD_LOOP_START).occupied_near_surface >= 0.95
+
+
+def test_a_scan_with_too_few_valid_beams_does_not_move_the_pose(loop):
+    """Fewer valid beams than minimumScore (50) cannot make a match: the correction stays."""
+    slam, _, _ = run(loop, indices=range(60))
+    before = slam.map_to_odom
+    ranges = np.full(len(loop.ranges[60]), math.nan)
+    ranges[::8] = loop.ranges[60][::8]  # 45 beams left
+    scan = Scan(loop.angle_min, loop.angle_increment, ranges, loop.range_min, loop.range_max)
+    pose = slam.update(12.0, loop.odom[60], scan, loop.scan_pose)
+    assert not slam.matched
+    assert slam.map_to_odom == before
+    assert pose == pytest.approx(compose(before, loop.odom[60]))
+    blind = Scan(loop.angle_min, loop.angle_increment, np.full(360, math.nan), loop.range_min, loop.range_max)
+    values = slam.map_values()
+    slam.update(12.6, loop.odom[61], blind, loop.scan_pose)
+    assert slam.map_to_odom == before and np.array_equal(slam.map_values(), values)
+
+
+def test_a_teleport_the_odometry_saw_is_followed(loop):
+    """After most of the loop the robot is put back where it was 56 s earlier, and the
+    odometry jumps there too (with its drift of then: 14 cm and 2.7 degrees from where
+    the map has it): the map takes it there and follows it for 20 s more."""
+    indices = list(range(0, 381)) + list(range(100, 200))
+    _, poses, jumps = run(loop, indices=indices)
+    assert np.flatnonzero(jumps).tolist() == [381]
+    distance, turn = errors(poses, loop.truth[indices])
+    assert distance.max() < 0.05 and turn.max() < math.radians(2.0)
+
+
+def test_an_odometry_reset_in_place_does_not_move_the_pose(loop, world):
+    """At 40 s the odometry restarts from zero while the robot drives on: the pose in the
+    map goes on, map -> odom takes the jump."""
+    odom = loop.odom.copy()
+    odom[200:] = relative(loop.odom[200], loop.odom[200:])
+    slam, poses, jumps = run(loop, odom=odom)
+    assert np.flatnonzero(jumps).tolist() == [200]
+    distance, turn = errors(poses, loop.truth)
+    assert distance.max() < 0.05 and turn.max() < math.radians(2.0)
+    assert quality(slam, world, WORLD_LOOP_START).occupied_near_surface >= 0.95
+
+
+def test_bad_odometry_and_a_blind_first_scan_change_nothing(loop):
+    slam = Slam()
+    scans = scans_of(loop)
+    blind = Scan(loop.angle_min, loop.angle_increment, np.full(360, math.nan), loop.range_min, loop.range_max)
+    slam.update(0.0, loop.odom[0], blind, loop.scan_pose)
+    assert slam.map_updates == 0 and np.all(slam.map_values() == -1)
+    slam.update(0.2, loop.odom[1], scans[1], loop.scan_pose)
+    assert slam.map_updates == 1  # the first scan that shows something starts the map
+    pose, values = slam.pose, slam.map_values()
+    assert slam.update(0.4, (math.nan, 0.0, 0.0), scans[2], loop.scan_pose) == pose
+    assert slam.update(0.6, (0.0, math.inf, 0.0), scans[3], loop.scan_pose) == pose
+    assert np.array_equal(slam.map_values(), values) and slam.map_to_odom == IDENTITY
+
+
+def test_time_going_back_restarts_the_temporal_rule(loop):
+    """As when the simulation is reset and its clock starts again at 0."""
+    slam, _, _ = run(loop, indices=range(40))  # then straight on up the west side: no turn adds a scan
+    scans, added = scans_of(loop), []
+    for step, index in enumerate(range(40, 46)):
+        updates = slam.map_updates
+        slam.update(0.2 * step, loop.odom[index], scans[index], loop.scan_pose)
+        added.append(slam.map_updates - updates)
+    assert added == [0, 0, 0, 1, 0, 0]  # 0.6 s after the stamp that went back
+
+
+def test_reset_starts_a_new_map(loop):
+    slam, _, _ = run(loop, indices=range(30))
+    slam.reset()
+    assert slam.pose is None and slam.map_to_odom == IDENTITY
+    assert np.all(slam.map_values() == -1)
+    pose = slam.update(0.0, loop.odom[30], scans_of(loop)[30], loop.scan_pose)
+    assert pose == pytest.approx(tuple(loop.odom[30]))
+    assert np.count_nonzero(slam.map_values() == 100) > 100
+
+
+@pytest.mark.parametrize('config, motion, added', [
+    (dict(), (0.0, 0.0), [0, 3, 6, 9, 12, 15, 18]),  # standing: every 0.5 s (temporalUpdate), so every third scan
+    (dict(temporalUpdate=-1.0), (0.0, 0.0), [0]),  # standing, no temporal rule: the first only
+    (dict(temporalUpdate=-1.0), (0.1, 0.0), [0, 10]),  # 0.1 m a scan: every 1 m (linearUpdate)
+    (dict(temporalUpdate=-1.0), (0.0, 0.06), [0, 4, 8, 12, 16]),  # 0.06 rad a scan: every 0.2 rad (angularUpdate)
+])
+def test_scans_are_added_by_gmappings_rule(loop, config, motion, added):
+    """One scan fed over and over at 5 Hz, the odometry moving by `motion` (m, rad) each
+    time; matching is off (minimumScore out of reach) so that the pose follows it."""
+    slam = Slam(SlamConfig(minimumScore=1e9, **config))
+    scan = scans_of(loop)[0]
+    when = []
+    for step in range(20):
+        updates = slam.map_updates
+        slam.update(0.2 * step, (motion[0] * step, 0.0, motion[1] * step), scan, loop.scan_pose)
+        if slam.map_updates > updates:
+            when.append(step)
+    assert when == added
+
+
+def test_defaults_are_turtlebot3s_and_bad_values_are_named():
+    config = SlamConfig()
+    assert {name: getattr(config, name) for name in TURTLEBOT3_GMAPPING} == TURTLEBOT3_GMAPPING
+    assert config.occ_thresh == 0.25  # gmapping's own default; turtlebot3_slam keeps it
+    for name, value in (('maxUrange', -1.0), ('delta', 0.0), ('xmax', -20.0), ('occ_thresh', 1.5),
+                        ('iterations', 2.5), ('sigma', math.nan), ('lskip', -1), ('maxRange', 2.0)):
+        with pytest.raises(SlamConfigError, match=r'parameter %s = %r' % (name, value)):
+            SlamConfig(**{name: value})
+    with pytest.raises(SlamConfigError, match="parameter maxUrange = 'far': must be a number"):
+        SlamConfig(maxUrange='far')
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        config.delta = 0.1
+
+
+def test_a_config_resolves_from_a_lookup_as_a_node_reads_its_parameters():
+    given = {'maxUrange': 4, 'iterations': 8.0, 'particles': 30}  # ints and floats as a launch file gives them
+    config = SlamConfig.resolve(lambda name, default: given.get(name, default))
+    assert config.maxUrange == 4.0 and isinstance(config.maxUrange, float)
+    assert config.iterations == 8 and isinstance(config.iterations, int)
+    assert config.delta == 0.05
+
+
+@pytest.fixture(scope='module')
+def tour():
+    """turtlebot3_house from the living room to the south-east room, 33 m (see drives.HOUSE_TOUR)."""
+    return record_drive('turtlebot3_house', HOUSE_TOUR_START, HOUSE_TOUR)
+
+
+def test_a_tour_of_the_house_drifts_too_little_to_double_walls(tour):
+    """A bound of 0.10 m (two cells) and 2 degrees on the pose all the way: a wall seen
+    again from a pose off by more than the matcher's reach (0.15 m) would be drawn anew
+    beside the old one. Measured: at most 2.4 cm (gained in the corridor, which tells
+    little along itself, and kept from there on: the map has no loop to close) and 0.85
+    degree (turning); odometry ends 25 cm and 2 degrees off. And the map, with the loop's
+    bounds: 100 % of its occupied cells near a surface, walls 1 cell, 0 % doubled, 0.3 %
+    thicker than 2 cells (the issue's coverage is for a whole house: this tour sees 41 %)."""
+    slam, poses, jumps = run(tour)
+    assert path_length(tour.truth) > 30.0 and not jumps.any()
+    distance, turn = errors(poses, tour.truth)
+    assert distance.max() < 0.10 and turn.max() < math.radians(2.0)
+    measured = quality(slam, obstacles('turtlebot3_house'), HOUSE_TOUR_START)
+    assert measured.occupied_near_surface >= 0.95 and measured.wall_thickness <= 2, measured.summary()
+    assert measured.doubled_wall_share < 0.005 and measured.thick_wall_share < 0.05, measured.summary()

@@ -1,8 +1,0 @@
-# Used by catkin_python_setup() only; do not run it by hand.
-from catkin_pkg.python_setup import generate_distutils_setup
-from setuptools import setup
-
-setup(**generate_distutils_setup(
-    packages=['tb3_navigation', 'tb3_navigation.ros'],
-    package_dir={'': 'src'},
-))

@@ -1,1 +1,0 @@
-"""The ROS edges of the navigation cores: one node a module, rospy only here."""
