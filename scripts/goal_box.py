@@ -25,6 +25,7 @@ import rospy
 from gazebo_msgs.msg import ModelState, ModelStates
 from gazebo_msgs.srv import DeleteModel, SetModelState, SpawnModel
 from geometry_msgs.msg import Pose
+from tb3_common.ros.poses import plane_pose
 
 GOAL = 'goal'
 GOAL_SDF = """<?xml version="1.0"?>
@@ -62,10 +63,7 @@ class RobotPose(object):
     def on_states(self, states):
         self.names = list(states.name)
         if self.robot in states.name:
-            pose = states.pose[states.name.index(self.robot)]
-            q = pose.orientation
-            yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-            self.pose = (pose.position.x, pose.position.y, yaw)
+            self.pose = plane_pose(states.pose[states.name.index(self.robot)])
 
 
 def corners(start, side):

@@ -7,9 +7,7 @@ import os
 import re
 import sys
 
-ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..')
-sys.path[:0] = [os.path.join(ROOT, 'src'), os.path.join(ROOT, 'tb3_navigation', 'src')]
-from tb3_sim_nav.params import FROM_MODEL, FROM_PROFILE, PARAMETERS, PROFILES  # noqa: E402
+from tb3_sim_nav.params import FROM_MODEL, FROM_PROFILE, PARAMETERS, PROFILES
 
 #: (node, parameter namespace, config class) of the navigation nodes, in doc/reference.md's order.
 NAVIGATION = [('tb3_slam', '', 'tb3_navigation.slam.SlamConfig'),
@@ -60,17 +58,18 @@ def main():
     print('| parameter | default | unit | meaning |')
     print('|---|---|---|---|')
     for parameter in PARAMETERS:
-        if parameter.origin == FROM_MODEL:
+        meta = parameter.metadata
+        if meta['origin'] == FROM_MODEL:
             default = "the model's"
-        elif parameter.origin == FROM_PROFILE:
+        elif meta['origin'] == FROM_PROFILE:
             default = ', '.join('%s: %s' % (profile, shown(PROFILES[profile][parameter.name]))
                                 for profile in sorted(PROFILES))
         elif parameter.default == ():
             default = '(none)'
         else:
             default = shown(parameter.default)
-        live = ' (live: `dynparam set`)' if parameter.live else ''
-        print('| `~%s` | %s | %s | %s%s |' % (parameter.name, default, parameter.unit, parameter.doc, live))
+        live = ' (live: `dynparam set`)' if meta['live'] else ''
+        print('| `~%s` | %s | %s | %s%s |' % (parameter.name, default, meta['unit'], meta['doc'], live))
 
 
 if __name__ == '__main__':

@@ -58,8 +58,8 @@ def test_dynparam_changes_a_live_parameter_at_once_logged_and_refuses_bad_values
     assert float(parameter('/tb3_sim/odom_angular_scale_correction')) == 0.99
     assert wait_until(lambda: 'dynamic_reconfigure: odom_angular_scale_correction = 0.99' in launch_log(sim),
                       TIMEOUT), 'the change is not in the simulator\'s log'
-    refusals = [('odom_angular_scale_correction', 'nan', 'must be a finite float'),
-                ('odom_linear_scale_correction', '7', 'must be between 0.5 and 2.0'),
+    refusals = [('odom_angular_scale_correction', 'nan', 'must be a finite number'),
+                ('odom_linear_scale_correction', '7', 'must be between 0.5 and 2'),
                 ('cmd_vel_timeout', '-1', 'must be >= 0')]
     for name, value, reason in refusals:
         before = parameter('/tb3_sim/' + name)

@@ -337,10 +337,10 @@ def test_reconfigure_changes_the_running_robot_and_refuses_bad_values(make_sim):
     assert abs(forward_speed(sim)) < 1e-3  # stopped 0.3 s after the command, not held
     before = sim.simulation.config
     for changes, problem in (({'caster_friction': -1.0}, 'must be >= 0'),
-                             ({'odom_linear_scale_correction': float('nan')}, 'must be a finite float'),
-                             ({'odom_angular_scale_correction': 3.0}, 'between 0.5 and 2.0'),
+                             ({'odom_linear_scale_correction': float('nan')}, 'must be a finite number'),
+                             ({'odom_angular_scale_correction': 3.0}, 'between 0.5 and 2'),
                              ({'physics_rate': 50.0}, 'cannot change while the simulator runs'),
-                             ({'encoder_noise': 0.01, 'left_motor_error': 0.9}, 'between -0.5 and 0.5')):
+                             ({'encoder_noise': 0.01, 'left_motor_error': 0.9}, '> -0.5 and < 0.5')):
         with pytest.raises(ParameterError, match=problem):
             sim.simulation.reconfigure(changes)
         assert sim.simulation.config == before  # nothing changed, not even the valid half

@@ -15,7 +15,8 @@ import os
 import threading
 import time
 
-from .report import normalize, yaw_of
+from tb3_common.pose2d import normalize_angle as normalize
+from tb3_common.ros.poses import fill_pose, plane_pose
 
 RVIZ_COVARIANCE = (0.25, 0.25, (math.pi / 12.0) ** 2)  # rviz's 2D Pose Estimate: x, y, yaw variances
 STATES = {0: 'PENDING', 1: 'ACTIVE', 2: 'PREEMPTED', 3: 'SUCCEEDED', 4: 'ABORTED', 5: 'REJECTED',
@@ -70,11 +71,8 @@ class Navigation(object):
 
     # --- recorders --------------------------------------------------------------------------
     def _on_truth(self, message):
-        pose = message.pose.pose
         with self._lock:
-            self.truth.append([message.header.stamp.to_sec(), pose.position.x, pose.position.y,
-                               yaw_of(pose.orientation.x, pose.orientation.y, pose.orientation.z,
-                                      pose.orientation.w)])
+            self.truth.append([message.header.stamp.to_sec()] + list(plane_pose(message)))
 
     def _on_plan(self, message):
         with self._lock:
@@ -84,24 +82,20 @@ class Navigation(object):
     def _on_cloud(self, message):
         import numpy as np
         from tb3_common.pose2d import normalize_angle
-        poses = np.array([(p.position.x, p.position.y, yaw_of(p.orientation.x, p.orientation.y, p.orientation.z,
-                                                                 p.orientation.w)) for p in message.poses])
+        poses = np.array([plane_pose(p) for p in message.poses])
         if not len(poses):
             return
         yaw = np.arctan2(np.sin(poses[:, 2]).mean(), np.cos(poses[:, 2]).mean())
         spread = (float(poses[:, 0].std()), float(poses[:, 1].std()),
-                  float(np.sqrt(np.mean(normalize_angle(poses[:, 2] - yaw) ** 2))))
+                  float(np.sqrt(np.mean(normalize(poses[:, 2] - yaw) ** 2))))
         with self._lock:
             self.spreads.append((message.header.stamp.to_sec(),) + spread + (len(poses),))
             if not self.clouds or message.header.stamp.to_sec() - self.clouds[-1][0] > 10.0:
                 self.clouds.append((message.header.stamp.to_sec(), poses[:, :2].tolist()))
 
     def _on_amcl(self, message):
-        pose = message.pose.pose
         with self._lock:
-            self.amcl.append([message.header.stamp.to_sec(), pose.position.x, pose.position.y,
-                              yaw_of(pose.orientation.x, pose.orientation.y, pose.orientation.z,
-                                     pose.orientation.w)])
+            self.amcl.append([message.header.stamp.to_sec()] + list(plane_pose(message)))
 
     def now_truth(self):
         with self._lock:
@@ -125,8 +119,7 @@ class Navigation(object):
         from geometry_msgs.msg import PoseWithCovarianceStamped
         message = PoseWithCovarianceStamped()
         message.header.frame_id, message.header.stamp = self.map_frame, rospy.Time.now()
-        message.pose.pose.position.x, message.pose.pose.position.y = x, y
-        message.pose.pose.orientation.z, message.pose.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+        fill_pose(message.pose.pose, (x, y, yaw))
         covariance = [0.0] * 36
         covariance[0], covariance[7], covariance[35] = RVIZ_COVARIANCE
         message.pose.covariance = covariance
@@ -139,8 +132,7 @@ class Navigation(object):
         goal = MoveBaseGoal()
         goal.target_pose.header.frame_id = self.map_frame if frame is None else frame
         goal.target_pose.header.stamp = rospy.Time.now()
-        goal.target_pose.pose.position.x, goal.target_pose.pose.position.y = x, y
-        goal.target_pose.pose.orientation.z, goal.target_pose.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+        fill_pose(goal.target_pose.pose, (x, y, yaw))
         self.client.send_goal(goal)
         return goal
 

@@ -15,10 +15,6 @@ import math
 import sys
 
 
-def _yaw(q):
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     parser.add_argument('--out', required=True, help='the JSON file written at the end')
@@ -28,6 +24,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
 
     import rospy
+    from tb3_common.ros.poses import plane_pose
     import tf2_ros
     from nav_msgs.msg import Odometry
     from tb3_common.ros import lifecycle
@@ -46,10 +43,10 @@ def main(argv=None):
             return
         due[0] = now + args.period
         pose = message.pose.pose
-        paths['truth'].append([now, pose.position.x, pose.position.y, _yaw(pose.orientation)])
+        paths['truth'].append([now] + list(plane_pose(pose)))
         try:
-            transform = buffer.lookup_transform(args.map_frame, args.base_frame, rospy.Time(0)).transform
-            paths['map'].append([now, transform.translation.x, transform.translation.y, _yaw(transform.rotation)])
+            transform = buffer.lookup_transform(args.map_frame, args.base_frame, rospy.Time(0))
+            paths['map'].append([now] + list(plane_pose(transform)))
         except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException):
             pass
 

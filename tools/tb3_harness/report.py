@@ -10,6 +10,8 @@ across runs of a test (`map_figures`: those of a map that a bound judges).
 import math
 from collections import namedtuple
 
+from tb3_common.pose2d import normalize_angle as normalize, yaw_of_quaternion as yaw_of  # noqa: F401 (for callers)
+
 RunResult = namedtuple('RunResult', 'script truth odom wall_time sim_time exit_code error')
 RunResult.__doc__ = """One script's run.
 
@@ -21,16 +23,6 @@ error: None, or what went wrong (text)
 
 Summary = namedtuple('Summary', 'start end odom_end error_distance error_heading '
                                 'drift_distance drift_heading travelled turned')
-
-
-def yaw_of(qx, qy, qz, qw):
-    """Heading (rad) of a quaternion, about z."""
-    return math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
-
-
-def normalize(angle):
-    """`angle` (rad) in [-pi, pi)."""
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def nearest(path, stamp):

@@ -13,15 +13,10 @@ simulator waits for it as for any node that publishes cmd_vel.
 """
 import argparse
 import json
-import math
 import sys
 
 RECORD_PERIOD = 0.5  # sim s between two recorded poses
 ROUTES = {'world_loop': 'WORLD_LOOP'}
-
-
-def _yaw(q):
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
 def main(argv=None):
@@ -33,6 +28,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
 
     import rospy
+    from tb3_common.ros.poses import plane_pose
     import tf2_ros
     from geometry_msgs.msg import Twist
     from nav_msgs.msg import Odometry
@@ -46,7 +42,7 @@ def main(argv=None):
     def keep(name):
         def store(message):
             pose = message.pose.pose
-            latest[name] = (pose.position.x, pose.position.y, _yaw(pose.orientation))
+            latest[name] = plane_pose(pose)
         return store
     rospy.Subscriber('base_pose_ground_truth', Odometry, keep('truth'), queue_size=1)
     rospy.Subscriber('odom', Odometry, keep('odom'), queue_size=1)
@@ -59,8 +55,8 @@ def main(argv=None):
         for name in ('truth', 'odom'):
             paths[name].append([now] + list(latest[name]))
         try:
-            transform = buffer.lookup_transform(args.map_frame, args.base_frame, rospy.Time(0)).transform
-            paths['map'].append([now, transform.translation.x, transform.translation.y, _yaw(transform.rotation)])
+            transform = buffer.lookup_transform(args.map_frame, args.base_frame, rospy.Time(0))
+            paths['map'].append([now] + list(plane_pose(transform)))
         except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException):
             pass
 

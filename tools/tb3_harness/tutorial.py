@@ -43,10 +43,8 @@ class Recorder(object):
 
     @staticmethod
     def _on_message(message, path):
-        pose = message.pose.pose
-        q = pose.orientation
-        path.append((message.header.stamp.to_sec(), pose.position.x, pose.position.y,
-                     report.yaw_of(q.x, q.y, q.z, q.w)))
+        from tb3_common.ros.poses import plane_pose
+        path.append((message.header.stamp.to_sec(),) + tuple(plane_pose(message)))
 
     def close(self):
         for subscriber in self.subscribers:

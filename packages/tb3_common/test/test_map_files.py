@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from tb3_common import map_files
+from tb3_common import map_files, pose2d
 from tb3_common.grid import Grid
 from tb3_common.pose2d import quaternion_of_yaw
 from tb3_common.map_files import MapFileError, SaverConfig
@@ -131,9 +131,9 @@ def test_the_yaml_yaw_is_tf2s_yaw_of_the_origin_quaternion():
     from tf.transformations import euler_from_quaternion, quaternion_from_euler
     for roll, pitch, yaw in [(0.0, 0.0, 0.7), (0.0, 0.0, -3.1), (0.3, -0.2, 2.5), (0.0, 0.0, math.pi / 2)]:
         q = quaternion_from_euler(roll, pitch, yaw)
-        assert map_files.yaw_of_quaternion(*q) == pytest.approx(euler_from_quaternion(q)[2], abs=1e-12)
+        assert pose2d.yaw_of_quaternion(*q) == pytest.approx(euler_from_quaternion(q)[2], abs=1e-12)
         # Not normalised: tf2's Matrix3x3 scales by 2 / |q|^2.
-        assert map_files.yaw_of_quaternion(*(2.0 * q)) == pytest.approx(yaw, abs=1e-12)
+        assert pose2d.yaw_of_quaternion(*(2.0 * q)) == pytest.approx(yaw, abs=1e-12)
     text = map_files.yaml_text('m.pgm', 0.05, (1.0, 2.0), quaternion_of_yaw(0.785398))
     assert 'origin: [1.000000, 2.000000, 0.785398]' in text
 

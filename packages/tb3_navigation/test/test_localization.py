@@ -73,10 +73,10 @@ def test_defaults_are_turtlebot3s_amcl_launch():
 
 
 @pytest.mark.parametrize('name, value, message', [
-    ('min_particles', 0, 'integer >= 1'), ('max_particles', 2.5, 'integer'), ('kld_err', 0.0, '> 0'),
-    ('update_min_d', -0.1, '>= 0'), ('resample_interval', 0, 'integer >= 1'), ('laser_max_beams', 1, '>= 2'),
-    ('laser_sigma_hit', 0.0, '> 0'), ('laser_z_rand', 1.5, '<= 1'), ('odom_alpha1', math.nan, 'finite'),
-    ('recovery_alpha_fast', 2.0, '<= 1'), ('laser_model_type', 'beam', 'likelihood_field'),
+    ('min_particles', 0, '>= 1'), ('max_particles', 2.5, 'whole number'), ('kld_err', 0.0, '> 0'),
+    ('update_min_d', -0.1, '>= 0'), ('resample_interval', 0, '>= 1'), ('laser_max_beams', 1, '>= 2'),
+    ('laser_sigma_hit', 0.0, '> 0'), ('laser_z_rand', 1.5, 'between 0 and 1'), ('odom_alpha1', math.nan, 'finite'),
+    ('recovery_alpha_fast', 2.0, 'between 0 and 1'), ('laser_model_type', 'beam', 'likelihood_field'),
     ('odom_model_type', 'omni', 'diff, diff-corrected'), ('base_frame_id', '', 'frame id'),
     ('initial_pose_x', math.inf, 'finite'), ('tf_broadcast', 'yes', 'true or false')])
 def test_bad_parameters_fail_naming_parameter_and_value(name, value, message):

@@ -17,6 +17,7 @@ cost, the area mapped) and one when it is done, with the explored area;
 then it stays, idle, as explore_lite does, until asked to end. It never
 touches the simulator: the map, tf and the action are all it sees.
 """
+import dataclasses
 import queue
 import threading
 import time
@@ -32,6 +33,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 from tb3_navigation.costmap import CostmapConfig
 from tb3_navigation.exploration import DONE, SEND, WAIT, Explorer
 from tb3_navigation.frontiers import BLACKLISTED, CANDIDATE, ExploreConfig, explored_area
+from tb3_common.params import Checked, frame_id, non_negative, parameter
 from tb3_common.pose2d import quaternion_of_yaw
 from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import Frames, namespaced
@@ -44,15 +46,23 @@ OTHER_COLOR = (0.5, 0.5, 0.5)  # too small, no room, unreachable
 GOAL_COLOR = (0.0, 1.0, 0.0)
 
 
+@dataclasses.dataclass(frozen=True)
+class NodeConfig(Checked):
+    """explore_lite's parameters of the node itself (the rule's are ExploreConfig's)."""
+    robot_base_frame: str = parameter('base_footprint', "the robot's frame (in a namespace: NAMESPACE/...)", frame_id)
+    costmap_topic: str = parameter('map', 'the map (an OccupancyGrid; its frame_id is the global frame)')
+    costmap_updates_topic: str = parameter('map_updates', "explore_lite's: map_msgs updates, not read here")
+    visualize: bool = parameter(True, 'publish the frontiers as markers on ~frontiers')
+    transform_tolerance: float = parameter(0.3, 'how old the robot pose may be', non_negative, 's')
+
+
 class ExploreNode(object):
 
     def __init__(self):
-        namespace = rospy.get_namespace()
-        self.base_frame = namespaced(str(rospy.get_param('~robot_base_frame', 'base_footprint')).lstrip('/'),
-                                     namespace)
-        self.topic = rospy.get_param('~costmap_topic', 'map')
-        self.visualize = bool(rospy.get_param('~visualize', True))
-        self.transform_tolerance = float(rospy.get_param('~transform_tolerance', 0.3))
+        node = params.read_or_exit(NODE, NodeConfig)
+        self.base_frame = namespaced(node.robot_base_frame, rospy.get_namespace())
+        self.topic, self.visualize, self.transform_tolerance = (node.costmap_topic, node.visualize,
+                                                                node.transform_tolerance)
         self.config = params.read_or_exit(NODE, ExploreConfig)
         self.explorer = Explorer(self.config, params.read_or_exit(NODE, CostmapConfig, 'costmap'))
         rospy.loginfo('%s: robot_base_frame %s, costmap_topic %s, visualize %s', NODE, self.base_frame,

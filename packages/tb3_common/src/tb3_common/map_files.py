@@ -31,7 +31,7 @@ import numpy as np
 import yaml
 
 from .grid import Grid
-from .pose2d import quaternion_of_yaw
+from .pose2d import quaternion_of_yaw, yaw_of_quaternion
 
 TRINARY, SCALE, RAW = 'trinary', 'scale', 'raw'
 MODES = (TRINARY, SCALE, RAW)
@@ -219,20 +219,6 @@ def load_map(path):
 
 
 # --- writing -------------------------------------------------------------------
-def yaw_of_quaternion(x, y, z, w):
-    """The yaw map_saver writes: tf2's Matrix3x3(q).getEulerYPR (q need not be normalised)."""
-    # Matrix3x3::setRotation's products in its order, so that rounding matches too.
-    s = 2.0 / (x * x + y * y + z * z + w * w)
-    ys, zs = y * s, z * s
-    m00 = 1.0 - (y * ys + z * zs)
-    m10 = x * ys + w * zs
-    m20 = x * zs - w * ys
-    if abs(m20) >= 1.0:  # pitch at +-90 degrees: tf2 gives yaw 0
-        return 0.0
-    cos_pitch = math.cos(-math.asin(m20))
-    return math.atan2(m10 / cos_pitch, m00 / cos_pitch)
-
-
 def pgm_bytes(values, resolution, threshold_occupied=65, threshold_free=25):
     """map_saver's PGM of int8 `values` [iy, ix]: header and pixels, the highest row first."""
     values = np.asarray(values).astype(np.int16)

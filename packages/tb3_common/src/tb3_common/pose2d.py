@@ -44,8 +44,9 @@ def transform_points(pose, points):
 
 
 def yaw_of_quaternion(x, y, z, w):
-    """The heading of a rotation given as a quaternion (its turn about z)."""
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    """The heading of a rotation given as a quaternion (x, y, z, w): its yaw as ZYX Euler angles, tf's
+    getEulerYPR's. The quaternion need not be normalised (a map_saver reads one from a YAML by hand)."""
+    return math.atan2(2.0 * (w * z + x * y), w * w + x * x - y * y - z * z)
 
 
 def quaternion_of_yaw(yaw):

@@ -63,6 +63,7 @@ from scipy import ndimage
 
 from .costmap import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE, Costmap, CostmapConfig, inflation_costs
 from tb3_common.grid import Grid
+from tb3_common.params import Checked, non_negative, parameter, positive
 from .grid_graph import path_to
 from .planner import GlobalPlanner, PlannerConfig
 
@@ -74,36 +75,32 @@ HEADING_BACK = 0.3  # m: the goal faces the way the path comes in over its last 
 WINDOW_MARGIN = 0.5  # m: of unknown space kept around the known part, beyond the inflation radius
 
 
+def _bounds(value):
+    if value == () or (len(value) == 4 and all(isinstance(bound, (int, float)) and not isinstance(bound, bool)
+                                               and math.isfinite(bound) for bound in value)
+                       and value[0] < value[2] and value[1] < value[3]):
+        return None
+    return 'must be [] or [xmin, ymin, xmax, ymax] with xmin < xmax and ymin < ymax'
+
+
 @dataclass(frozen=True)
-class ExploreConfig:
+class ExploreConfig(Checked):
     """explore_lite's parameters, with explore_lite's explore.launch values (TurtleBot3 has none
     of its own); blacklist_radius (explore_lite: a square of +-5 cells) and max_wall_distance (0:
     no limit) are this rule's."""
-    planner_frequency: float = 0.33
-    progress_timeout: float = 30.0
-    potential_scale: float = 3.0
-    orientation_scale: float = 0.0
-    gain_scale: float = 1.0
-    min_frontier_size: float = 0.5
-    blacklist_radius: float = 0.25
-    max_wall_distance: float = 2.5
-    explore_bounds: tuple = ()  # (xmin, ymin, xmax, ymax) in the map: no goal outside; (): anywhere
-
-    def __post_init__(self):
-        for name in ('planner_frequency', 'progress_timeout', 'potential_scale', 'orientation_scale', 'gain_scale',
-                     'min_frontier_size', 'blacklist_radius', 'max_wall_distance'):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-                    or value < 0:
-                raise ValueError('%s must be a finite number >= 0, not %r' % (name, value))
-        if not self.planner_frequency > 0:
-            raise ValueError('planner_frequency must be > 0, not %r' % (self.planner_frequency,))
-        bounds = self.explore_bounds
-        if bounds != () and not (len(bounds) == 4 and all(
-                isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-                for value in bounds) and bounds[0] < bounds[2] and bounds[1] < bounds[3]):
-            raise ValueError('explore_bounds must be [] or [xmin, ymin, xmax, ymax] with xmin < xmax and '
-                             'ymin < ymax, not %r' % (bounds,))
+    planner_frequency: float = parameter(0.33, 'how often a new frontier is chosen', positive, 'Hz')
+    progress_timeout: float = parameter(30.0, 'a goal the robot makes no progress towards for this long is '
+                                              'blacklisted', non_negative, 's')
+    potential_scale: float = parameter(3.0, "weight of the frontier's distance in its cost", non_negative)
+    orientation_scale: float = parameter(0.0, "weight of the turn towards it", non_negative)
+    gain_scale: float = parameter(1.0, "weight of the frontier's size", non_negative)
+    min_frontier_size: float = parameter(0.5, 'smaller frontiers are left out', non_negative, 'm')
+    blacklist_radius: float = parameter(0.25, 'frontiers this near a blacklisted goal are left out', non_negative,
+                                        'm')
+    max_wall_distance: float = parameter(2.5, 'no goal farther than this from every known wall; 0: no limit',
+                                         non_negative, 'm')
+    explore_bounds: tuple = parameter((), 'no goal outside [xmin, ymin, xmax, ymax] in the map; []: anywhere',
+                                      _bounds, 'm')
 
 
 @dataclass(frozen=True)

@@ -9,9 +9,8 @@ import time
 
 import rospy
 import tf2_ros
-from geometry_msgs.msg import TransformStamped
 
-from ..pose2d import quaternion_of_yaw, yaw_of_quaternion
+from .poses import plane_pose, transform_stamped
 
 WARN_PERIOD = 10.0  # wall s between repeats of one warning
 CACHE = 30.0        # s of tf history kept (tf2's default is 10)
@@ -24,12 +23,6 @@ def namespaced(frame, namespace):
     if not namespace or '/' in frame:
         return frame
     return namespace + '/' + frame
-
-
-def pose_of(transform):
-    """(x, y, yaw) of a geometry_msgs/Transform."""
-    t, r = transform.translation, transform.rotation
-    return t.x, t.y, yaw_of_quaternion(r.x, r.y, r.z, r.w)
 
 
 class Frames(object):
@@ -58,12 +51,7 @@ class Frames(object):
         except (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException) as error:
             self.warn((target, source), 'waiting for tf %s -> %s: %s', target, source, error)
             return None
-        return pose_of(transform.transform)
+        return plane_pose(transform)
 
     def send(self, parent, child, pose, stamp):
-        transform = TransformStamped()
-        transform.header.frame_id, transform.header.stamp, transform.child_frame_id = parent, stamp, child
-        transform.transform.translation.x, transform.transform.translation.y = pose[0], pose[1]
-        (transform.transform.rotation.x, transform.transform.rotation.y, transform.transform.rotation.z,
-         transform.transform.rotation.w) = quaternion_of_yaw(pose[2])
-        self.broadcaster.sendTransform(transform)
+        self.broadcaster.sendTransform(transform_stamped(parent, child, pose, stamp))

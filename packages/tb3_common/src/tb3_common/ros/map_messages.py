@@ -8,8 +8,7 @@ from geometry_msgs.msg import Point, Pose, Quaternion
 from nav_msgs.msg import MapMetaData, OccupancyGrid
 
 from ..grid import Grid
-from ..map_files import yaw_of_quaternion
-from ..pose2d import quaternion_of_yaw
+from ..pose2d import quaternion_of_yaw, yaw_of_quaternion
 
 
 def map_metadata(grid, load_time, orientation=None):

@@ -1,54 +1,57 @@
-"""A core's typed config read from a node's private parameters, once, checked, logged.
+"""A node's config read from its private parameters, once, checked, logged (tb3_common.params's rules).
 
-Each core keeps its parameters in a frozen dataclass whose field names are
-the ROS original's parameter names (gmapping's `maxUrange`, amcl's
-`laser_max_beams`...) and whose defaults are TurtleBot3's values; the
-dataclass checks its own values (ValueError naming the parameter). A node
-reads every field from `~name` (or `~namespace/name`, as move_base's
-`DWAPlannerROS/max_vel_x`), logs the resolved set once, and on a bad value
-ends at start-up with that message and exit status 2.
+A node reads every field of its config dataclass (a tb3_common.params.Checked)
+from `~name` (or `~namespace/name`, as move_base's `DWAPlannerROS/max_vel_x`),
+logs the resolved set once, and on a bad value ends at start-up with the
+message naming the parameter and the value, exit status 2. Parameters of
+the original that the node takes but cannot honour (gmapping's particles,
+say) are named in a warning at start when they are set.
 """
 import dataclasses
 import sys
 
 import rospy
 
+from ..params import ParameterError
 
-def _typed(field, value):
-    """`value` as the field's type: ints are fine where floats go, never bools."""
-    kind = field.type if isinstance(field.type, type) else type(field.default)
-    if isinstance(value, bool) and kind is not bool:
-        raise ValueError('parameter ~%s = %r: must be a %s, not a bool' % (field.name, value, kind.__name__))
-    if kind is float and isinstance(value, int):
-        return float(value)
-    if kind is tuple and isinstance(value, list):
-        return tuple(tuple(item) if isinstance(item, list) else item for item in value)
-    if kind in (float, int, bool, str, tuple) and not isinstance(value, kind):
-        raise ValueError('parameter ~%s = %r: must be a %s' % (field.name, value, kind.__name__))
-    return value
+
+def _prefix(namespace):
+    return '~' + (namespace.strip('/') + '/' if namespace else '')
 
 
 def read(config_class, namespace='', overrides=None):
-    """A `config_class` from the node's private parameters `~namespace/NAME`
-    (the field's default where unset; `overrides` {name: value} win over both)."""
-    prefix = '~' + (namespace.rstrip('/') + '/' if namespace else '')
+    """A `config_class` from the node's private parameters `~namespace/NAME` (the field's default
+    where unset; `overrides` {name: value} win over both)."""
+    prefix = _prefix(namespace)
     values = {}
     for field in dataclasses.fields(config_class):
         if overrides and field.name in overrides:
             values[field.name] = overrides[field.name]
         else:
-            values[field.name] = _typed(field, rospy.get_param(prefix + field.name, field.default))
+            values[field.name] = rospy.get_param(prefix + field.name, field.default)
     return config_class(**values)
 
 
-def read_or_exit(node, config_class, namespace='', overrides=None):
+def warn_unhonoured(node, unhonoured, namespace=''):
+    """A warning for each parameter of `unhonoured` {name: why} that is set: the original's, taken
+    here without effect (a launch file written for the original sets it)."""
+    prefix = _prefix(namespace)
+    for name, why in sorted(unhonoured.items()):
+        if rospy.has_param(prefix + name):
+            rospy.logwarn('%s: parameter %s%s = %r has no effect here: %s', node, prefix, name,
+                          rospy.get_param(prefix + name), why)
+
+
+def read_or_exit(node, config_class, namespace='', overrides=None, unhonoured=None):
     """read(), the resolved set logged once; a bad value ends the node (exit 2) with its message."""
     try:
         config = read(config_class, namespace, overrides)
-    except (ValueError, TypeError) as error:
+    except (ParameterError, ValueError, TypeError) as error:
         rospy.logfatal('%s cannot start: %s', node, error)
         rospy.signal_shutdown('bad parameter')
         sys.exit(2)
+    if unhonoured:
+        warn_unhonoured(node, unhonoured, namespace)
     rospy.loginfo('%s parameters%s: %s', node, ' (%s)' % namespace if namespace else '',
                   ', '.join('%s=%r' % (field.name, getattr(config, field.name))
                             for field in dataclasses.fields(config)))
