@@ -1,0 +1,1 @@
+"""multirobot_map_merge: its parameters (config), robot discovery (discovery), the merge (merge), the node."""

@@ -1,0 +1,308 @@
+"""Launch files written for the real nodes run unchanged (issue 29): tf's static_transform_publisher,
+fake_localization and multirobot_map_merge, each started by a launch file as the ROS world writes them.
+
+- A launch file in the style of the ROS wiki's tutorials starts tf's
+  static_transform_publisher in both argument forms; tf2 finds the
+  transforms, right and future-dated; bad arguments print tf's usage.
+- fake_localization beside `roslaunch tb3_sim_bringup tb3_world.launch`,
+  with map_server and move_base (a launch of its own, including ours):
+  a goal is reached, and amcl_pose is the truth.
+- ROBOTIS' multi-robot chapter: `roslaunch tb3_sim_bringup multi_tb3.launch`,
+  `ROS_NAMESPACE=tb3_N roslaunch tb3_sim_bringup tb3_slam.launch` for the
+  three robots, then ROBOTIS' multi_map_merge.launch as ROBOTIS writes it
+  (map_merge and three static_transform_publishers); each robot turns a
+  little, and the merged /map holds every robot's known cells, its walls on
+  the house's.
+
+Every look from ROS's side is a short python process (PROBE below): this
+process starts a master per test and cannot be a rospy node of each.
+"""
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+import rospkg
+
+from tb3_common.map_files import load_map
+from tb3_harness.map_quality import measure
+from tb3_sim_nav.world_file import load_world
+from tb3_system_utils import wait_until
+from test_multi_robot_maps import ROBOTS
+
+
+
+def _burger(**variables):
+    """This process's environment (its master's, set by the ros_port fixture) for a Burger, plus `variables`."""
+    return dict(os.environ, TURTLEBOT3_MODEL='burger', **variables)
+
+
+# The ROS wiki's way (tf tutorials, "static_transform_publisher" in a launch file): leading slashes, both forms.
+TUTORIAL_LAUNCH = """<launch>
+  <node pkg="tf" type="static_transform_publisher" name="laser_broadcaster"
+        args="0.1 0 0.2 0 0 0 /base_link /laser 100" />
+  <node pkg="tf" type="static_transform_publisher" name="camera_broadcaster"
+        args="0.05 0 0.3 1.5707963 0 0 base_link camera_link 100" />
+  <node pkg="tf" type="static_transform_publisher" name="link1_broadcaster"
+        args="1 0 0 0 0 0.7071068 0.7071068 link1_parent link1 100" />
+</launch>
+"""
+#: parent, child: translation, rotation (x, y, z, w) the tutorial's launch gives them
+TUTORIAL_TRANSFORMS = {
+    ('base_link', 'laser'): ((0.1, 0.0, 0.2), (0.0, 0.0, 0.0, 1.0)),
+    ('base_link', 'camera_link'): ((0.05, 0.0, 0.3), (0.0, 0.0, math.sqrt(0.5), math.sqrt(0.5))),
+    ('link1_parent', 'link1'): ((1.0, 0.0, 0.0), (0.0, 0.0, math.sqrt(0.5), math.sqrt(0.5)))}
+PERIOD = 0.1  # s: the launch's 100 ms
+
+# A launch file for fake_localization as the wild writes one (frames with a slash), with our move_base.
+FAKE_LOCALIZATION_LAUNCH = """<launch>
+  <node pkg="map_server" type="map_server" name="map_server" args="$(find tb3_sim_nav)/maps/turtlebot3_world.yaml"/>
+  <node pkg="fake_localization" type="fake_localization" name="fake_localization" output="screen">
+    <param name="global_frame_id" value="/map"/>
+    <param name="base_frame_id" value="/base_footprint"/>
+  </node>
+  <include file="$(find tb3_sim_nav)/launch/move_base.launch"/>
+</launch>
+"""
+WORLD_GOAL = (-0.55, -0.55, 0.0)  # test_navigation's first, past the west pillars' row
+XY_TOLERANCE = 0.05               # DWAPlannerROS's, TurtleBot3's
+
+# ROBOTIS-GIT/turtlebot3_simulations (noetic), turtlebot3_gazebo/launch/multi_map_merge.launch, as it is (a
+# backslash at a line's end only folds a long line here: the string has it whole).
+MULTI_MAP_MERGE_LAUNCH = """<launch>
+  <arg name="first_tb3"  default="tb3_0"/>
+  <arg name="second_tb3" default="tb3_1"/>
+  <arg name="third_tb3"  default="tb3_2"/>
+
+  <arg name="first_tb3_x_pos" default="-7.0"/>
+  <arg name="first_tb3_y_pos" default="-1.0"/>
+  <arg name="first_tb3_z_pos" default=" 0.0"/>
+  <arg name="first_tb3_yaw"   default=" 0.0"/>
+
+  <arg name="second_tb3_x_pos" default=" 7.0"/>
+  <arg name="second_tb3_y_pos" default="-1.0"/>
+  <arg name="second_tb3_z_pos" default=" 0.0"/>
+  <arg name="second_tb3_yaw"   default=" 0.0"/>
+
+  <arg name="third_tb3_x_pos" default=" 0.5"/>
+  <arg name="third_tb3_y_pos" default=" 3.0"/>
+  <arg name="third_tb3_z_pos" default=" 0.0"/>
+  <arg name="third_tb3_yaw"   default=" 0.0"/>
+
+  <group ns="$(arg first_tb3)/map_merge">
+    <param name="init_pose_x"   value="$(arg first_tb3_x_pos)"/>
+    <param name="init_pose_y"   value="$(arg first_tb3_y_pos)"/>
+    <param name="init_pose_z"   value="$(arg first_tb3_z_pos)"/>
+    <param name="init_pose_yaw" value="$(arg first_tb3_yaw)"  />
+  </group>
+
+  <group ns="$(arg second_tb3)/map_merge">
+    <param name="init_pose_x"   value="$(arg second_tb3_x_pos)"/>
+    <param name="init_pose_y"   value="$(arg second_tb3_y_pos)"/>
+    <param name="init_pose_z"   value="$(arg second_tb3_z_pos)"/>
+    <param name="init_pose_yaw" value="$(arg second_tb3_yaw)"  />
+  </group>
+
+  <group ns="$(arg third_tb3)/map_merge">
+    <param name="init_pose_x"   value="$(arg third_tb3_x_pos)"/>
+    <param name="init_pose_y"   value="$(arg third_tb3_y_pos)"/>
+    <param name="init_pose_z"   value="$(arg third_tb3_z_pos)"/>
+    <param name="init_pose_yaw" value="$(arg third_tb3_yaw)"  />
+  </group>
+
+  <node pkg="multirobot_map_merge" type="map_merge" respawn="false" name="map_merge" output="screen">
+    <param name="robot_map_topic" value="map"/>
+    <param name="robot_namespace" value="tb3"/>
+    <param name="merged_map_topic" value="map"/>
+    <param name="world_frame" value="map"/>
+    <param name="known_init_poses" value="true"/>
+    <param name="merging_rate" value="0.5"/>
+    <param name="discovery_rate" value="0.05"/>
+    <param name="estimation_rate" value="0.1"/>
+    <param name="estimation_confidence" value="1.0"/>
+  </node>
+
+  <node pkg="tf" type="static_transform_publisher" name="world_to_$(arg first_tb3)_tf_broadcaster"\
+  args="0 0 0 0 0 0 /map /$(arg first_tb3)/map 100"/>
+  <node pkg="tf" type="static_transform_publisher" name="world_to_$(arg second_tb3)_tf_broadcaster"\
+ args="0 0 0 0 0 0 /map /$(arg second_tb3)/map 100"/>
+  <node pkg="tf" type="static_transform_publisher" name="world_to_$(arg third_tb3)_tf_broadcaster"\
+ args="0 0 0 0 0 0 /map /$(arg third_tb3)/map 100"/>
+</launch>
+
+<!-- http://wiki.ros.org/multirobot_map_merge -->"""
+DRIVE_SECONDS = 12.0      # sim s each robot turns on a small circle: a look all round from its spawn
+KNOWN_IN_MERGED = 0.97    # share of each robot's known cells the merged map knows too
+NEAR_SURFACE = 0.95       # share of the merged map's occupied cells within 0.10 m of the house's surfaces
+
+# The ROS side's looks, one short python process each: `python3 -c PROBE MODE ARGS...`, one JSON line out.
+PROBE = r'''
+import json, math, sys
+import rospy
+mode, args = sys.argv[1], sys.argv[2:]
+rospy.init_node('probe', anonymous=True)
+if mode == 'tf':  # parent child ...: each transform, and its stamp less now (s)
+    import tf2_ros
+    buffer = tf2_ros.Buffer()
+    listener = tf2_ros.TransformListener(buffer)
+    found = {}
+    for parent, child in zip(args[::2], args[1::2]):
+        t = buffer.lookup_transform(parent, child, rospy.Time(0), rospy.Duration(20.0))
+        found[parent + ' ' + child] = dict(
+            translation=[t.transform.translation.x, t.transform.translation.y, t.transform.translation.z],
+            rotation=[t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z, t.transform.rotation.w],
+            ahead=(t.header.stamp - rospy.Time.now()).to_sec())
+    print(json.dumps(found))
+elif mode == 'drive':  # seconds linear angular settle namespace...: every robot on a circle, then still
+    from geometry_msgs.msg import Twist
+    seconds, linear, angular, settle = (float(value) for value in args[:4])
+    publishers = [rospy.Publisher(ns + '/cmd_vel', Twist, queue_size=1) for ns in args[4:]]
+    while rospy.Time.now().is_zero():
+        rospy.sleep(0.01)
+    start, rate = rospy.get_time(), rospy.Rate(10)
+    twist = Twist()
+    twist.linear.x, twist.angular.z = linear, angular
+    while rospy.get_time() - start < seconds:
+        for publisher in publishers:
+            publisher.publish(twist)
+        rate.sleep()
+    for _ in range(5):
+        for publisher in publishers:
+            publisher.publish(Twist())
+        rate.sleep()
+    rospy.sleep(settle)
+    print(json.dumps(dict(sim_seconds=rospy.get_time() - start)))
+elif mode == 'goal':  # x y yaw: move_base's outcome, the true pose and amcl_pose at the end
+    import actionlib
+    from geometry_msgs.msg import PoseWithCovarianceStamped
+    from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
+    from nav_msgs.msg import Odometry
+    x, y, yaw = (float(value) for value in args)
+    client = actionlib.SimpleActionClient('move_base', MoveBaseAction)
+    assert client.wait_for_server(rospy.Duration(120.0)), 'no move_base'
+    goal = MoveBaseGoal()
+    goal.target_pose.header.frame_id, goal.target_pose.header.stamp = 'map', rospy.Time.now()
+    goal.target_pose.pose.position.x, goal.target_pose.pose.position.y = x, y
+    goal.target_pose.pose.orientation.z, goal.target_pose.pose.orientation.w = math.sin(yaw / 2), math.cos(yaw / 2)
+    client.send_goal(goal)
+    client.wait_for_result(rospy.Duration(120.0))
+    rospy.sleep(1.0)
+    def pose(message):
+        p, q = message.pose.pose.position, message.pose.pose.orientation
+        return [p.x, p.y, math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z))]
+    truth = rospy.wait_for_message('base_pose_ground_truth', Odometry, 10.0)
+    estimate = rospy.wait_for_message('amcl_pose', PoseWithCovarianceStamped, 10.0)
+    print(json.dumps(dict(state=client.get_state(), truth=pose(truth), amcl=pose(estimate),
+                          amcl_frame=estimate.header.frame_id, stamps=[truth.header.stamp.to_sec(),
+                                                                       estimate.header.stamp.to_sec()])))
+'''
+
+
+def _probe(processes, name, mode, *args, timeout=120.0):
+    """The JSON a PROBE run printed (AssertionError with its output if it failed)."""
+    process = processes.start(name, [sys.executable, '-c', PROBE, mode] + [str(arg) for arg in args])
+    code = process.wait(timeout)
+    output = process.output(100000)
+    assert code == 0, '%s: exit %r\n%s' % (name, code, output)
+    return json.loads(output.strip().splitlines()[-1])
+
+
+def _launch_file(tmp_path, name, text):
+    path = os.path.join(str(tmp_path), name)
+    with open(path, 'w') as stream:
+        stream.write(text)
+    return path
+
+
+def test_the_tutorial_s_static_transform_publishers(ros_port, processes, tmp_path):
+    processes.start_master('roscore', ros_port)
+    launch = processes.start('tutorial', ['roslaunch', _launch_file(tmp_path, 'tf_tutorial.launch', TUTORIAL_LAUNCH)])
+    found = _probe(processes, 'probe_tf', 'tf', *[frame for pair in TUTORIAL_TRANSFORMS for frame in pair])
+    for (parent, child), (translation, rotation) in TUTORIAL_TRANSFORMS.items():
+        seen = found[parent + ' ' + child]
+        print('MEASURED %s -> %s: %s, %s, stamped %+.3f s from now' % (parent, child, seen['translation'],
+                                                                    seen['rotation'], seen['ahead']))
+        assert np.allclose(seen['translation'], translation, atol=1e-9)
+        assert np.allclose(seen['rotation'], rotation, atol=1e-6)
+        # future-dated by the period, as tf's: the latest is never older than now, less a little latency
+        assert -0.05 < seen['ahead'] <= PERIOD + 0.01, seen
+    assert launch.running(), launch.describe()
+
+
+def test_static_transform_publisher_refuses_bad_arguments_and_ends_at_once(ros_port, processes):
+    bad = processes.start('bad', ['rosrun', 'tf', 'static_transform_publisher', '1', '2', '3'])
+    assert bad.wait(30.0) == 255, bad.describe()
+    assert 'Usage: static_transform_publisher x y z yaw pitch roll frame_id child_frame_id' in bad.output()
+    processes.start_master('roscore', ros_port)
+    node = processes.start('node', ['rosrun', 'tf', 'static_transform_publisher', '0', '0', '0', '0', '0', '0',
+                                    'map', 'odom', '100'])
+    _probe(processes, 'probe_node', 'tf', 'map', 'odom')
+    began = time.monotonic()
+    node.stop()
+    took = time.monotonic() - began
+    print('MEASURED static_transform_publisher ended %.2f s after SIGINT' % took)
+    assert took < 2.0
+
+
+def test_fake_localization_drives_move_base_to_a_goal(ros_port, processes, tmp_path):
+    processes.start_master('roscore', ros_port)
+    sim = processes.start('sim', ['roslaunch', 'tb3_sim_bringup', 'tb3_world.launch', 'real_time_factor:=0'],
+                          env=_burger())
+    nav = processes.start('nav', ['roslaunch', _launch_file(tmp_path, 'fake_nav.launch', FAKE_LOCALIZATION_LAUNCH)],
+                          env=_burger())
+    outcome = _probe(processes, 'probe_goal', 'goal', *WORLD_GOAL, timeout=240.0)
+    truth, estimate = outcome['truth'], outcome['amcl']
+    error = math.hypot(truth[0] - WORLD_GOAL[0], truth[1] - WORLD_GOAL[1])
+    print('MEASURED fake_localization + move_base: state %d, %.3f m from the goal, amcl_pose %.4f m from the truth'
+          % (outcome['state'], error, math.hypot(truth[0] - estimate[0], truth[1] - estimate[1])))
+    assert outcome['state'] == 3, (outcome, nav.output())  # SUCCEEDED
+    assert error <= XY_TOLERANCE + 0.01
+    assert outcome['amcl_frame'] == 'map'
+    assert math.hypot(truth[0] - estimate[0], truth[1] - estimate[1]) < 0.01  # the robot stands still: same pose
+    log = sim.output(200000)
+    assert 'fake_localization publishes map -> odom' in log, log[-3000:]  # the simulator gave way
+
+
+def test_robotis_multi_map_merge_merges_the_three_robots_maps(ros_port, processes, tmp_path):
+    processes.start_master('roscore', ros_port)
+    folder = str(tmp_path)
+    processes.start('sim', ['roslaunch', 'tb3_sim_bringup', 'multi_tb3.launch', 'real_time_factor:=0'], env=_burger())
+    for name in ROBOTS:
+        processes.start('slam_' + name, ['roslaunch', 'tb3_sim_bringup', 'tb3_slam.launch', 'open_rviz:=false'],
+                        env=_burger(ROS_NAMESPACE=name))
+    import rosgraph
+    master = rosgraph.Master('/test_real_node_names')
+    assert wait_until(lambda: all(['/%s/map' % name, 'nav_msgs/OccupancyGrid'] in master.getPublishedTopics('/')
+                                  for name in ROBOTS), 120.0), 'no map topic of each robot'
+    merger = processes.start('multi_map_merge', ['roslaunch', _launch_file(tmp_path, 'multi_map_merge.launch',
+                                                                           MULTI_MAP_MERGE_LAUNCH)], env=_burger())
+    drove = _probe(processes, 'probe_drive', 'drive', DRIVE_SECONDS, 0.05, 0.6, 6.0, *ROBOTS, timeout=240.0)
+    maps = {}
+    for name, topic in [(name, '/%s/map' % name) for name in ROBOTS] + [('merged', '/map')]:
+        saver = processes.start('saver_' + name, ['rosrun', 'map_server', 'map_saver', '-f',
+                                                  os.path.join(folder, name), 'map:=' + topic])
+        assert saver.wait(60.0) == 0, saver.describe()
+        maps[name] = load_map(os.path.join(folder, name + '.yaml'))
+    log = merger.output(100000)
+    for name in ROBOTS:
+        assert 'adding robot [/%s]' % name in log, log
+        assert 'where tf puts %s/map in map' % name in log, log
+    merged = maps['merged']
+    obstacles = load_world('turtlebot3_house', os.path.join(rospkg.RosPack().get_path('tb3_sim_nav'),
+                                                             'worlds')).obstacles
+    quality = measure(merged.grid, merged.values, obstacles, ROBOTS['tb3_0'])
+    print('MEASURED merged map after %.1f s of sim time: %d x %d cells at %.3f m, occupied near a surface %.1f %%'
+          % (drove['sim_seconds'], merged.grid.width, merged.grid.height, merged.grid.resolution,
+             100 * quality.occupied_near_surface))
+    assert quality.occupied_near_surface >= NEAR_SURFACE, quality.summary()
+    for name in ROBOTS:
+        own = maps[name]
+        centres = own.grid.all_centres()[own.values >= 0]  # the robot's known cells, in its map (= the world's)
+        cells = merged.grid.to_cells(centres)
+        inside = merged.grid.inside(cells)
+        known = np.zeros(len(centres), dtype=bool)
+        known[inside] = merged.values[cells[inside][:, 1], cells[inside][:, 0]] >= 0
+        print('MEASURED %s: %d known cells, %.1f %% known in the merged map' % (name, len(centres), 100 * known.mean()))
+        assert len(centres) > 1000 and known.mean() >= KNOWN_IN_MERGED
