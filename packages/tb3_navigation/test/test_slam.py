@@ -8,9 +8,10 @@ import math
 import numpy as np
 import pytest
 
+from tb3_common.params import ParameterError
 from tb3_common.pose2d import IDENTITY, compose, normalize_angle, relative
 from tb3_navigation.scan import Scan
-from tb3_navigation.slam import Slam, SlamConfig, SlamConfigError
+from tb3_navigation.slam import Slam, SlamConfig
 from tb3_harness.map_quality import measure
 from tb3_sim_nav.world_file import load_world
 
@@ -245,17 +246,16 @@ def test_defaults_are_turtlebot3s_and_bad_values_are_named():
     assert config.occ_thresh == 0.25  # gmapping's own default; turtlebot3_slam keeps it
     for name, value in (('maxUrange', -1.0), ('delta', 0.0), ('xmax', -20.0), ('occ_thresh', 1.5),
                         ('iterations', 2.5), ('sigma', math.nan), ('lskip', -1), ('maxRange', 2.0)):
-        with pytest.raises(SlamConfigError, match=r'parameter %s = %r' % (name, value)):
+        with pytest.raises(ParameterError, match=r'parameter ~%s = %r' % (name, value)):
             SlamConfig(**{name: value})
-    with pytest.raises(SlamConfigError, match="parameter maxUrange = 'far': must be a number"):
+    with pytest.raises(ParameterError, match="parameter ~maxUrange = 'far': must be a number"):
         SlamConfig(maxUrange='far')
     with pytest.raises(dataclasses.FrozenInstanceError):
         config.delta = 0.1
 
 
-def test_a_config_resolves_from_a_lookup_as_a_node_reads_its_parameters():
-    given = {'maxUrange': 4, 'iterations': 8.0, 'particles': 30}  # ints and floats as a launch file gives them
-    config = SlamConfig.resolve(lambda name, default: given.get(name, default))
+def test_a_config_takes_ints_and_floats_as_a_launch_file_gives_them():
+    config = SlamConfig(maxUrange=4, iterations=8.0)
     assert config.maxUrange == 4.0 and isinstance(config.maxUrange, float)
     assert config.iterations == 8 and isinstance(config.iterations, int)
     assert config.delta == 0.05

@@ -1,6 +1,8 @@
 """The SLAM node: gmapping's interface over tb3_navigation.slam.
 
-    roslaunch tb3_sim_bringup tb3_slam.launch      # or: rosrun gmapping slam_gmapping
+    roslaunch turtlebot3_slam turtlebot3_slam.launch    # ROBOTIS' (node turtlebot3_slam_gmapping)
+    roslaunch tb3_sim_bringup tb3_slam.launch           # ours (node tb3_slam)
+    rosrun gmapping slam_gmapping                       # node slam_gmapping, as gmapping names itself
 
 Subscribes `scan` and tf odom -> base_footprint; publishes latched `map` and
 `map_metadata` (every map_update_interval of scan time, as gmapping), tf
@@ -9,9 +11,11 @@ lookups at a scan's time succeed, as gmapping's); serves `dynamic_map`.
 Each scan is handled in its own callback, start to end, so a simulator in
 lockstep waits for it (and the map does not depend on the speed).
 
-In a namespace (`ROS_NAMESPACE=tb3_0`), frames not given are the namespace's
-(tb3_0/odom, tb3_0/base_footprint, tb3_0/map), as ROBOTIS' multi-robot SLAM
-sets them; topics are the namespace's (/tb3_0/scan, /tb3_0/map).
+It takes every parameter gmapping takes (gmapping.config): those of its
+particle filter are named in a warning at start, with why they mean nothing
+here. In a namespace (`ROS_NAMESPACE=tb3_0`), frames not given are the
+namespace's (tb3_0/odom, tb3_0/base_footprint, tb3_0/map), as ROBOTIS'
+multi-robot SLAM sets them; topics are the namespace's (/tb3_0/scan, /tb3_0/map).
 """
 import threading
 
@@ -20,42 +24,40 @@ from nav_msgs.msg import MapMetaData, OccupancyGrid
 from nav_msgs.srv import GetMap, GetMapResponse
 from sensor_msgs.msg import LaserScan
 
+from gmapping.config import UNHONOURED, NodeConfig
 from tb3_navigation.scan import Scan
 from tb3_navigation.slam import Slam, SlamConfig
 from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import Frames, namespaced
 from tb3_common.ros.map_messages import occupancy_grid
 
-NODE = 'tb3_slam'
-#: What turtlebot3_slam.launch's slam_methods may ask for: each runs this node (and says so).
-METHODS = ('tb3', 'gmapping', 'cartographer', 'hector', 'karto', 'frontier_exploration')
+NODE = 'slam_gmapping'  # gmapping's own name for it; a launch file gives another (tb3_slam, turtlebot3_slam_gmapping)
 
 
 class SlamNode(object):
 
     def __init__(self, life):
         self.life = life
+        self.name = rospy.get_name().rsplit('/', 1)[-1]
+        node = params.read_or_exit(self.name, NodeConfig, unhonoured=UNHONOURED)
         namespace = rospy.get_namespace()
-        self.base_frame = rospy.get_param('~base_frame', namespaced('base_footprint', namespace))
-        self.odom_frame = rospy.get_param('~odom_frame', namespaced('odom', namespace))
-        self.map_frame = rospy.get_param('~map_frame', namespaced('map', namespace))
-        self.transform_publish_period = float(rospy.get_param('~transform_publish_period', 0.05))
-        self.tf_delay = float(rospy.get_param('~tf_delay', self.transform_publish_period))
-        method = rospy.get_param('~slam_methods', 'tb3')
-        if method not in METHODS:
-            rospy.logfatal('%s cannot start: slam_methods %r: must be one of %s', NODE, method, ', '.join(METHODS))
-            raise SystemExit(2)
-        if method != 'tb3':
+        self.base_frame = node.base_frame or namespaced('base_footprint', namespace)
+        self.odom_frame = node.odom_frame or namespaced('odom', namespace)
+        self.map_frame = node.map_frame or namespaced('map', namespace)
+        self.transform_publish_period, self.tf_delay = node.transform_publish_period, node.stamp_ahead
+        self.throttle_scans = node.throttle_scans
+        if node.slam_methods != 'tb3':
             rospy.loginfo('%s: slam_methods %s asked for; Debian has none of those: running tb3_navigation\'s '
-                          'SLAM (scan-to-map matching) with gmapping\'s interface and TurtleBot3\'s values', NODE,
-                          method)
-        self.config = params.read_or_exit(NODE, SlamConfig)
-        rospy.loginfo('%s: frames %s -> %s -> %s, transform_publish_period %g s', NODE, self.map_frame,
+                          'SLAM (scan-to-map matching) with gmapping\'s interface and TurtleBot3\'s values',
+                          self.name, node.slam_methods)
+        self.config = params.read_or_exit(self.name, SlamConfig)
+        rospy.loginfo('%s: frames %s -> %s -> %s, transform_publish_period %g s', self.name, self.map_frame,
                       self.odom_frame, self.base_frame, self.transform_publish_period)
         self.slam = Slam(self.config)
-        self.frames = Frames(NODE)
+        self.frames = Frames(self.name)
         self._lock = threading.Lock()  # the core, between the scan callback and the tf timer and service
         self._sensors = {}  # scan frame -> its pose in the base frame (static: asked once)
+        self._scans = 0  # scans heard, for throttle_scans
         self._last_stamp = None
         self._published_updates = -1
         self._last_map_stamp = None
@@ -76,6 +78,9 @@ class SlamNode(object):
         return self._sensors[frame]
 
     def _on_scan(self, message):
+        self._scans += 1
+        if self._scans % self.throttle_scans:
+            return  # gmapping's throttle_scans: the n-th, 2n-th... scans are used
         stamp = message.header.stamp
         sensor = self._sensor_pose(message.header.frame_id, stamp)
         odom = self.frames.pose(self.odom_frame, self.base_frame, stamp, timeout=0.5) if sensor else None
@@ -84,14 +89,14 @@ class SlamNode(object):
         with self._lock:
             if self._last_stamp is not None and stamp < self._last_stamp:
                 rospy.logwarn('%s: time went back (%.2f s -> %.2f s: a simulation reset or a new simulator): '
-                              'starting a new map', NODE, self._last_stamp.to_sec(), stamp.to_sec())
+                              'starting a new map', self.name, self._last_stamp.to_sec(), stamp.to_sec())
                 self.slam.reset()
                 self._last_map_stamp, self._published_updates = None, -1
             self._last_stamp = stamp
             self.slam.update(stamp.to_sec(), odom, Scan.from_message(message), sensor)
             if self.slam.jumped:
                 rospy.loginfo('%s: the odometry jumped (a reset or a teleport) at %.2f s; the pose in %s is '
-                              '(%.2f, %.2f, %.2f), matched: %s', NODE, stamp.to_sec(), self.map_frame,
+                              '(%.2f, %.2f, %.2f), matched: %s', self.name, stamp.to_sec(), self.map_frame,
                               *(tuple(self.slam.pose) + (self.slam.matched,)))
             due = (self._last_map_stamp is None
                    or (stamp - self._last_map_stamp).to_sec() > self.config.map_update_interval)

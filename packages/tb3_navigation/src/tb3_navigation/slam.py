@@ -39,12 +39,12 @@ Bad input, and what it does:
 """
 import dataclasses
 import math
-import numbers
 
 import numpy as np
 
 from . import matcher
 from .occupancy import OccupancyGrid
+from tb3_common.params import Checked, fail, non_negative, number, parameter, positive
 from tb3_common.pose2d import IDENTITY, compose, inverse, relative
 
 
@@ -53,84 +53,55 @@ from tb3_common.pose2d import IDENTITY, compose, inverse, relative
 JUMP_SEARCH = 3
 
 
-class SlamConfigError(ValueError):
-    pass
-
-
 @dataclasses.dataclass(frozen=True)
-class SlamConfig(object):
+class SlamConfig(Checked):
     """gmapping's parameters (its names) with turtlebot3_slam's values, and the few of our own.
 
     gmapping's particle filter's own (particles, srr, srt, str, stt,
     resampleThreshold, ogain, lsigma, kernelSize, ll/lasample*) mean nothing
-    here; resolve() does not ask for them. odom_weight 20: the worst pose
-    error on the house tour was 6.4 cm with 0, 2.4 cm with 20, 5.4 cm with 80.
+    here: the node (gmapping.node) takes them and says so. odom_weight 20:
+    the worst pose error on the house tour was 6.4 cm with 0, 2.4 cm with 20,
+    5.4 cm with 80.
     """
-    maxUrange: float = 3.0  # m: beams are used for the map and matching up to here; longer ones only clear
-    maxRange: float = 0.0  # m: hits longer than this are dropped whole; 0 = the scan's range_max
-    delta: float = 0.05  # m: the map's cell
-    xmin: float = -10.0  # m: the map's extent in the map frame; its origin is (xmin, ymin)
-    ymin: float = -10.0  # m
-    xmax: float = 10.0  # m
-    ymax: float = 10.0  # m
-    linearUpdate: float = 1.0  # m driven before a scan is added to the map
-    angularUpdate: float = 0.2  # rad turned before a scan is added to the map
-    temporalUpdate: float = 0.5  # s since the last added scan before one is added anyway; < 0: never
-    map_update_interval: float = 2.0  # s between two maps the node publishes
-    occ_thresh: float = 0.25  # share of a cell's sightings that were hits above which it is occupied
-    minimumScore: float = 50.0  # a match scoring less (about: fewer beams on the map's walls) is not used
-    sigma: float = 0.05  # m: the likelihood field's width
-    lstep: float = 0.05  # m: step of the correlative search
-    astep: float = 0.05  # rad: step of the correlative search
-    iterations: int = 5  # Gauss-Newton steps after the search
-    odom_weight: float = 20.0  # end points' worth of pull towards the odometry's prediction in those steps
-    lskip: int = 0  # match with every (lskip + 1)-th beam
-    search_linear: float = 0.10  # m: the correlative search's reach around the prediction
-    search_angular: float = 0.10  # rad: its reach in heading
-    jump_distance: float = 0.5  # m between two scans' odometry poses taken for a jump, not a drive
-    jump_angle: float = 1.0  # rad, likewise (the Burger turns at most 2.84 rad/s: 0.57 rad in 0.2 s)
+    maxUrange: float = parameter(3.0, 'm: beams are used for the map and matching up to here; longer ones only clear',
+                                 positive, 'm')
+    maxRange: float = parameter(0.0, "m: hits longer than this are dropped whole; 0 = the scan's range_max",
+                                non_negative, 'm')
+    delta: float = parameter(0.05, "m: the map's cell", positive, 'm')
+    xmin: float = parameter(-10.0, "m: the map's extent in the map frame; its origin is (xmin, ymin)", None, 'm')
+    ymin: float = parameter(-10.0, 'm', None, 'm')
+    xmax: float = parameter(10.0, 'm', None, 'm')
+    ymax: float = parameter(10.0, 'm', None, 'm')
+    linearUpdate: float = parameter(1.0, 'm driven before a scan is added to the map', non_negative, 'm')
+    angularUpdate: float = parameter(0.2, 'rad turned before a scan is added to the map', non_negative, 'rad')
+    temporalUpdate: float = parameter(0.5, 's since the last added scan before one is added anyway; < 0: never',
+                                      None, 's')
+    map_update_interval: float = parameter(2.0, 's between two maps the node publishes', positive, 's')
+    occ_thresh: float = parameter(0.25, "share of a cell's sightings that were hits above which it is occupied",
+                                  number(0.0, 1.0, high_open=True))
+    minimumScore: float = parameter(50.0, "a match scoring less (about: fewer beams on the map's walls) is not used",
+                                    non_negative)
+    sigma: float = parameter(0.05, "m: the likelihood field's width", positive, 'm')
+    lstep: float = parameter(0.05, 'm: step of the correlative search', positive, 'm')
+    astep: float = parameter(0.05, 'rad: step of the correlative search', positive, 'rad')
+    iterations: int = parameter(5, 'Gauss-Newton steps after the search', number(0))
+    odom_weight: float = parameter(20.0, "end points' worth of pull towards the odometry's prediction in those steps",
+                                   non_negative)
+    lskip: int = parameter(0, 'match with every (lskip + 1)-th beam', number(0))
+    search_linear: float = parameter(0.10, "m: the correlative search's reach around the prediction", non_negative,
+                                     'm')
+    search_angular: float = parameter(0.10, 'rad: its reach in heading', non_negative, 'rad')
+    jump_distance: float = parameter(0.5, "m between two scans' odometry poses taken for a jump, not a drive",
+                                     positive, 'm')
+    jump_angle: float = parameter(1.0, 'rad, likewise (the Burger turns at most 2.84 rad/s: 0.57 rad in 0.2 s)',
+                                  positive, 'rad')
 
-    @classmethod
-    def resolve(cls, lookup):
-        """The config of `lookup(name, default)` for every field: in the node, rospy.get_param
-        on '~' + name, read once at start-up."""
-        return cls(**{field.name: lookup(field.name, field.default) for field in dataclasses.fields(cls)})
-
-    def __post_init__(self):
-        for field in dataclasses.fields(self):
-            value = getattr(self, field.name)
-            if isinstance(value, bool) or not isinstance(value, numbers.Real):
-                raise SlamConfigError('parameter %s = %r: must be a number' % (field.name, value))
-            if not math.isfinite(value):
-                raise SlamConfigError('parameter %s = %r: must be finite' % (field.name, value))
-            if field.type is int and value != int(value):
-                raise SlamConfigError('parameter %s = %r: must be a whole number' % (field.name, value))
-            # 5.0 from a launch file is the 5 iterations meant; 3 is the 3.0 m meant.
-            object.__setattr__(self, field.name, (int if field.type is int else float)(value))
-        for name, good, problem in (
-                ('maxUrange', self.maxUrange > 0, 'must be > 0'),
-                ('maxRange', self.maxRange == 0 or self.maxRange >= self.maxUrange,
-                 "must be 0 (the scan's range_max) or >= maxUrange (%r)" % self.maxUrange),
-                ('delta', self.delta > 0, 'must be > 0'),
-                ('xmax', self.xmax - self.xmin >= self.delta, 'must exceed xmin (%r) by delta at least' % self.xmin),
-                ('ymax', self.ymax - self.ymin >= self.delta, 'must exceed ymin (%r) by delta at least' % self.ymin),
-                ('linearUpdate', self.linearUpdate >= 0, 'must be >= 0'),
-                ('angularUpdate', self.angularUpdate >= 0, 'must be >= 0'),
-                ('map_update_interval', self.map_update_interval > 0, 'must be > 0'),
-                ('occ_thresh', 0 <= self.occ_thresh < 1, 'must be in [0, 1)'),
-                ('minimumScore', self.minimumScore >= 0, 'must be >= 0'),
-                ('sigma', self.sigma > 0, 'must be > 0'),
-                ('lstep', self.lstep > 0, 'must be > 0'),
-                ('astep', self.astep > 0, 'must be > 0'),
-                ('iterations', self.iterations >= 0, 'must be >= 0'),
-                ('odom_weight', self.odom_weight >= 0, 'must be >= 0'),
-                ('lskip', self.lskip >= 0, 'must be >= 0'),
-                ('search_linear', self.search_linear >= 0, 'must be >= 0'),
-                ('search_angular', self.search_angular >= 0, 'must be >= 0'),
-                ('jump_distance', self.jump_distance > 0, 'must be > 0'),
-                ('jump_angle', self.jump_angle > 0, 'must be > 0')):
-            if not good:
-                raise SlamConfigError('parameter %s = %r: %s' % (name, getattr(self, name), problem))
+    def check_together(self):
+        if self.maxRange and self.maxRange < self.maxUrange:
+            fail('maxRange', self.maxRange, "must be 0 (the scan's range_max) or >= maxUrange (%r)" % self.maxUrange)
+        for low, high in (('xmin', 'xmax'), ('ymin', 'ymax')):
+            if getattr(self, high) - getattr(self, low) < self.delta:
+                fail(high, getattr(self, high), 'must exceed %s (%r) by delta at least' % (low, getattr(self, low)))
 
 
 class Slam(object):
