@@ -1,4 +1,5 @@
-"""The keyboard teleop (scripts/tb3_teleop_key), typed at through a pseudo-terminal.
+"""The keyboard teleop (turtlebot3_teleop's turtlebot3_teleop_key; scripts/tb3_teleop_key and
+tb3_sim_bringup's tb3_teleop_key.launch run the same node), typed at through a pseudo-terminal.
 
 The tests share a roscore on a free loopback port, its parameters cleared
 between tests (conftest.py's shared_master); the one without a master has a
@@ -30,6 +31,9 @@ from tb3_system_utils import Echo, alive, harness, poses, run, wait_until
 
 TELEOP = ['rosrun', 'tb3_sim_nav', 'tb3_teleop_key']
 MULTI = ['roslaunch', 'tb3_sim_bringup', 'multi_tb3.launch']
+ROBOTIS = ['roslaunch', 'turtlebot3_teleop', 'turtlebot3_teleop_key.launch']
+#: ROBOTIS' e-manual, typed as it is there.
+EMANUAL = ['bash', '-c', 'export TURTLEBOT3_MODEL=burger && roslaunch turtlebot3_teleop turtlebot3_teleop_key.launch']
 NAMESPACED = 'ROS_NAMESPACE=tb3_0 rosrun tb3_sim_nav tb3_teleop_key'  # the README's, for one of several
 LIMITS = {'burger': (0.22, 2.84), 'waffle': (0.26, 1.82), 'waffle_pi': (0.26, 1.82)}
 LINEAR_HALF_STEP = 0.005   # m/s: the profile's change per message
@@ -42,6 +46,7 @@ SIM_READY = 60.0      # wall s for the simulator's first ground truth
 PRINT_WITHIN = 5.0    # wall s for a key's target line to be printed
 REACH_WITHIN = 20.0   # wall s for cmd_vel to reach a target (0.1 s per half step)
 EXIT_WITHIN = 10.0    # wall s for the teleop to exit once asked
+CTRL_C_WITHIN = 2.0   # wall s from Ctrl+C on roslaunch to the end of the node (every node of ours)
 REST_WITHIN = 10.0    # wall s for the robot to be at rest after the teleop exited
 TURN = 0.6            # rad the robot must turn left before its path is judged
 
@@ -278,12 +283,15 @@ def test_exit_publishes_a_stop_the_robot_rests_the_terminal_is_restored(how, tru
 
 
 @pytest.mark.parametrize('model, via', [('burger', 'param'), ('waffle', 'param'),
-                                        ('burger', 'env'), ('waffle_pi', 'env')])
+                                        ('burger', 'env'), ('waffle_pi', 'env'), ('waffle_pi', 'robotis_launch')])
 def test_speeds_held_to_the_model_limits(model, via, master, processes, tmp_path, monkeypatch):
     argv = TELEOP
     if via == 'param':   # ~model wins over an environment that says otherwise
         argv = TELEOP + ['_model:=' + model]
         monkeypatch.setenv('TURTLEBOT3_MODEL', 'waffle' if model == 'burger' else 'burger')
+    elif via == 'robotis_launch':   # ROBOTIS' launch gives the node `model` (not ~model): it wins too
+        argv = ROBOTIS + ['model:=' + model]
+        monkeypatch.setenv('TURTLEBOT3_MODEL', 'burger')
     else:
         monkeypatch.setenv('TURTLEBOT3_MODEL', model)
     linear, angular = LIMITS[model]
@@ -400,3 +408,30 @@ def test_in_a_namespace_it_drives_one_robot_of_three(master, processes, tmp_path
     assert abs(now['x'] - start['x']) < 0.01  # ahead is +y for tb3_0 (yaw 1.57)
     assert math.hypot(other_now['x'] - other['x'], other_now['y'] - other['y']) < 1e-3
     type_and_see(teleop, 's', 0.0, 0.0)
+
+
+def test_robotis_launch_typed_as_the_emanual_drives_and_ends_within_2_s_of_ctrl_c(truth, processes, tmp_path):
+    """`export TURTLEBOT3_MODEL=burger`, then `roslaunch turtlebot3_teleop turtlebot3_teleop_key.launch`:
+    the keys drive the robot ahead; Ctrl+C in that terminal ends the node within 2 s, a stop published
+    and the terminal restored."""
+    cmd_vel = Echo(processes, '/cmd_vel')
+    launch = start_teleop(processes, tmp_path, cmd_vel, name='emanual_teleop', argv=EMANUAL)
+    assert '(burger: at most 0.22 m/s and 2.84 rad/s)' in launch.output(), launch.output()
+    start = last(poses(truth))
+    type_and_see(launch, 'w' * 5, 0.05, 0.0)
+    wait_for_twist(cmd_vel, 0.05, 0.0)
+    assert wait_until(lambda: last(poses(truth))['x'] - start['x'] > 0.05, REACH_WITHIN), \
+        'the robot did not drive 5 cm ahead: %s -> %s' % (start, last(poses(truth)))
+    node = run(['rosnode', 'info', '/turtlebot3_teleop_keyboard'], 30.0).stdout
+    pid = int(re.search(r'Pid: (\d+)', node).group(1))
+
+    launch.type('\x03')
+    pressed = time.monotonic()
+    gone = wait_until(lambda: not alive(pid), 10.0, poll=0.02)
+    took = time.monotonic() - pressed
+    print('MEASURED e-manual teleop: the node ended %.2f s after Ctrl+C' % took)
+    assert gone and took <= CTRL_C_WITHIN, 'the teleop ran %.1f s after Ctrl+C' % took
+    assert wait_until(lambda: not launch.running(), 30.0), 'roslaunch still runs 30 s after Ctrl+C'
+    assert wait_until(lambda: last(twists(cmd_vel)) == ZERO, 5.0), last(twists(cmd_vel))
+    assert wait_until(lambda: at_rest(truth), REST_WITHIN), last(poses(truth))
+    assert 'Stopped' in launch.output() and launch.settings() == launch.settings_before, launch.output()[-2000:]
