@@ -64,7 +64,7 @@ def accuracy(drives, seeds):
         late = distance > distance[-1] / 4.0
         near = np.zeros(len(drive.times), dtype=bool)
         for goal in goals:
-            near |= np.hypot(*(drive.truth[:, :2] - goal).T) < AT_GOAL
+            near |= np.hypot(*(drive.truth[:, :2] - goal[:2]).T) < AT_GOAL
         cells = {}
         for refine in (True, False):
             errors = []

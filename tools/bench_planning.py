@@ -19,7 +19,7 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
-from tb3_harness.nav_sim import SCAN_POSE, Lidar, costmaps, world_cut (the tests' world, lidar and map)
+from tb3_harness.nav_sim import SCAN_POSE, Lidar, costmaps, world_cut  # the tests' world, lidar and map
 from tb3_harness.measure import machine
 from tb3_navigation.controller import DwaController, dwa_config
 from tb3_navigation.costmap import Costmap, CostmapConfig

@@ -79,6 +79,11 @@ part 1 rostests "cd .ws && timeout --signal=INT --kill-after=60 3600 catkin_make
 part 2 test_explore "$pytest test/system/test_explore.py"
 part 2 test_multi_robot_maps "$pytest test/system/test_multi_robot_maps.py"
 part 2 test_emanual "$pytest test/system/test_emanual.py"
+# ROBOTIS' names (issue 29): the e-manual's simulation commands (a drive as fast as possible, Ctrl+C's
+# 2 s), launch files written for the real nodes (three SLAMs and map_merge), the ROS wiki's navigation.
+part 2 test_turtlebot3_gazebo "$pytest test/system/test_turtlebot3_gazebo.py"
+part 2 test_real_node_names "$pytest test/system/test_real_node_names.py"
+part 2 test_wiki_style_navigation "$pytest test/system/test_wiki_style_navigation.py"
 # The root package's unit tests and every package's own (packages/*/test).
 [ -n "$integration_only" ] || part 2 unit "$pytest test/unit $(ls -d packages/*/test)"
 part 2 test_calibration.busy_core "$pytest test/system/test_calibration.py -k busy_core"

@@ -17,6 +17,8 @@ import time
 from tb3_harness import processes as harness
 
 MASTER_TIMEOUT = 30.0   # wall s for a roscore to answer
+#: The three robots of multi_tb3.launch and ROBOTIS' multi_turtlebot3.launch in turtlebot3_house, at their spawns.
+ROBOTS = {'tb3_0': (-7.0, -1.0), 'tb3_1': (7.0, -1.0), 'tb3_2': (0.5, 3.0)}
 
 
 def master_uri(port):

@@ -28,8 +28,8 @@ from tb3_harness.processes import Process, start_master, wait_until
 from tb3_harness.report import figure
 from tb3_common.map_files import load_map
 from tb3_sim_nav.world_file import load_world
+from tb3_system_utils import ROBOTS
 
-ROBOTS = {'tb3_0': (-7.0, -1.0), 'tb3_1': (7.0, -1.0), 'tb3_2': (0.5, 3.0)}  # multi_tb3.launch's spawns
 EXPLORE_SIM_SECONDS = 60.0   # of exploration each robot gets (sim time of its explorer's goals)
 TIMEOUT = 900.0              # wall s for that (3 robots, 9 of our nodes and the simulator on 2 cores)
 MIN_FREE = 8.0               # m2 of free floor each robot must have mapped round its spawn

@@ -18,13 +18,11 @@ import os
 import pytest
 import rospkg
 
-from tb3_harness.navigating import Navigation, clearance
+from tb3_harness.navigating import WORLD_GOALS, Navigation, clearance
 from tb3_harness.processes import Process, start_master, wait_until
 from tb3_harness.report import figure
 
 SPAWN = (-2.0, -0.5, 0.0)  # tb3_world.launch's
-#: Around and between the pillars (0.15 m radius, 1.1 m apart).
-GOALS = [(-0.55, -0.55, 0.0), (0.55, 0.55, math.pi / 2), (1.65, -0.55, -math.pi / 2), (-0.55, 1.65, math.pi)]
 XY_TOLERANCE, YAW_TOLERANCE = 0.05, 0.17  # DWAPlannerROS's, TurtleBot3's
 CLEARANCE = 0.09          # m: the footprint never nearer to a pillar or wall
 BURGER_FOOTPRINT = [(-0.105, -0.105), (-0.105, 0.105), (0.041, 0.105), (0.041, -0.105)]
@@ -74,7 +72,7 @@ def world_obstacles():
 
 def test_four_goals_around_the_pillars_succeed_within_the_tolerances(navigation):
     obstacles = world_obstacles()
-    for goal in GOALS:
+    for goal in WORLD_GOALS:  # around and between the pillars (0.15 m radius, 1.1 m apart)
         outcome = navigation.go(*goal)
         least = clearance(outcome.path, obstacles, BURGER_FOOTPRINT)
         print('MEASURED goal (%.2f, %.2f, %.2f): %s in %.1f s of sim time; truly %.3f m and %.3f rad off '

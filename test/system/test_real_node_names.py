@@ -7,12 +7,12 @@ fake_localization and multirobot_map_merge, each started by a launch file as the
 - fake_localization beside `roslaunch tb3_sim_bringup tb3_world.launch`,
   with map_server and move_base (a launch of its own, including ours):
   a goal is reached, and amcl_pose is the truth.
-- ROBOTIS' multi-robot chapter: `roslaunch tb3_sim_bringup multi_tb3.launch`,
-  `ROS_NAMESPACE=tb3_N roslaunch tb3_sim_bringup tb3_slam.launch` for the
-  three robots, then ROBOTIS' multi_map_merge.launch as ROBOTIS writes it
-  (map_merge and three static_transform_publishers); each robot turns a
-  little, and the merged /map holds every robot's known cells, its walls on
-  the house's.
+- ROBOTIS' multi-robot chapter as the e-manual types it: `roslaunch
+  turtlebot3_gazebo multi_turtlebot3.launch`, `roslaunch turtlebot3_gazebo
+  multi_turtlebot3_slam.launch ns:=tb3_N` for the three robots, then
+  `roslaunch turtlebot3_gazebo multi_map_merge.launch` (map_merge and three
+  of tf's static_transform_publishers); each robot turns a little, and the
+  merged /map holds every robot's known cells, its walls on the house's.
 
 Every look from ROS's side is a short python process (PROBE below): this
 process starts a master per test and cannot be a rospy node of each.
@@ -29,8 +29,7 @@ import rospkg
 from tb3_common.map_files import load_map
 from tb3_harness.map_quality import measure
 from tb3_sim_nav.world_file import load_world
-from tb3_system_utils import wait_until
-from test_multi_robot_maps import ROBOTS
+from tb3_system_utils import ROBOTS, wait_until
 
 
 
@@ -71,68 +70,6 @@ XY_TOLERANCE = 0.05               # DWAPlannerROS's, TurtleBot3's
 
 # ROBOTIS-GIT/turtlebot3_simulations (noetic), turtlebot3_gazebo/launch/multi_map_merge.launch, as it is (a
 # backslash at a line's end only folds a long line here: the string has it whole).
-MULTI_MAP_MERGE_LAUNCH = """<launch>
-  <arg name="first_tb3"  default="tb3_0"/>
-  <arg name="second_tb3" default="tb3_1"/>
-  <arg name="third_tb3"  default="tb3_2"/>
-
-  <arg name="first_tb3_x_pos" default="-7.0"/>
-  <arg name="first_tb3_y_pos" default="-1.0"/>
-  <arg name="first_tb3_z_pos" default=" 0.0"/>
-  <arg name="first_tb3_yaw"   default=" 0.0"/>
-
-  <arg name="second_tb3_x_pos" default=" 7.0"/>
-  <arg name="second_tb3_y_pos" default="-1.0"/>
-  <arg name="second_tb3_z_pos" default=" 0.0"/>
-  <arg name="second_tb3_yaw"   default=" 0.0"/>
-
-  <arg name="third_tb3_x_pos" default=" 0.5"/>
-  <arg name="third_tb3_y_pos" default=" 3.0"/>
-  <arg name="third_tb3_z_pos" default=" 0.0"/>
-  <arg name="third_tb3_yaw"   default=" 0.0"/>
-
-  <group ns="$(arg first_tb3)/map_merge">
-    <param name="init_pose_x"   value="$(arg first_tb3_x_pos)"/>
-    <param name="init_pose_y"   value="$(arg first_tb3_y_pos)"/>
-    <param name="init_pose_z"   value="$(arg first_tb3_z_pos)"/>
-    <param name="init_pose_yaw" value="$(arg first_tb3_yaw)"  />
-  </group>
-
-  <group ns="$(arg second_tb3)/map_merge">
-    <param name="init_pose_x"   value="$(arg second_tb3_x_pos)"/>
-    <param name="init_pose_y"   value="$(arg second_tb3_y_pos)"/>
-    <param name="init_pose_z"   value="$(arg second_tb3_z_pos)"/>
-    <param name="init_pose_yaw" value="$(arg second_tb3_yaw)"  />
-  </group>
-
-  <group ns="$(arg third_tb3)/map_merge">
-    <param name="init_pose_x"   value="$(arg third_tb3_x_pos)"/>
-    <param name="init_pose_y"   value="$(arg third_tb3_y_pos)"/>
-    <param name="init_pose_z"   value="$(arg third_tb3_z_pos)"/>
-    <param name="init_pose_yaw" value="$(arg third_tb3_yaw)"  />
-  </group>
-
-  <node pkg="multirobot_map_merge" type="map_merge" respawn="false" name="map_merge" output="screen">
-    <param name="robot_map_topic" value="map"/>
-    <param name="robot_namespace" value="tb3"/>
-    <param name="merged_map_topic" value="map"/>
-    <param name="world_frame" value="map"/>
-    <param name="known_init_poses" value="true"/>
-    <param name="merging_rate" value="0.5"/>
-    <param name="discovery_rate" value="0.05"/>
-    <param name="estimation_rate" value="0.1"/>
-    <param name="estimation_confidence" value="1.0"/>
-  </node>
-
-  <node pkg="tf" type="static_transform_publisher" name="world_to_$(arg first_tb3)_tf_broadcaster"\
-  args="0 0 0 0 0 0 /map /$(arg first_tb3)/map 100"/>
-  <node pkg="tf" type="static_transform_publisher" name="world_to_$(arg second_tb3)_tf_broadcaster"\
- args="0 0 0 0 0 0 /map /$(arg second_tb3)/map 100"/>
-  <node pkg="tf" type="static_transform_publisher" name="world_to_$(arg third_tb3)_tf_broadcaster"\
- args="0 0 0 0 0 0 /map /$(arg third_tb3)/map 100"/>
-</launch>
-
-<!-- http://wiki.ros.org/multirobot_map_merge -->"""
 DRIVE_SECONDS = 12.0      # sim s each robot turns on a small circle: a look all round from its spawn
 KNOWN_IN_MERGED = 0.97    # share of each robot's known cells the merged map knows too
 NEAR_SURFACE = 0.95       # share of the merged map's occupied cells within 0.10 m of the house's surfaces
@@ -268,16 +205,18 @@ def test_fake_localization_drives_move_base_to_a_goal(ros_port, processes, tmp_p
 def test_robotis_multi_map_merge_merges_the_three_robots_maps(ros_port, processes, tmp_path):
     processes.start_master('roscore', ros_port)
     folder = str(tmp_path)
-    processes.start('sim', ['roslaunch', 'tb3_sim_bringup', 'multi_tb3.launch', 'real_time_factor:=0'], env=_burger())
+    # The e-manual's commands, each in a terminal of its own (+ real_time_factor:=0, ours).
+    processes.start('sim', ['roslaunch', 'turtlebot3_gazebo', 'multi_turtlebot3.launch', 'real_time_factor:=0'],
+                    env=_burger())
     for name in ROBOTS:
-        processes.start('slam_' + name, ['roslaunch', 'tb3_sim_bringup', 'tb3_slam.launch', 'open_rviz:=false'],
-                        env=_burger(ROS_NAMESPACE=name))
+        processes.start('slam_' + name, ['roslaunch', 'turtlebot3_gazebo', 'multi_turtlebot3_slam.launch',
+                                         'ns:=' + name], env=_burger())
     import rosgraph
     master = rosgraph.Master('/test_real_node_names')
     assert wait_until(lambda: all(['/%s/map' % name, 'nav_msgs/OccupancyGrid'] in master.getPublishedTopics('/')
                                   for name in ROBOTS), 120.0), 'no map topic of each robot'
-    merger = processes.start('multi_map_merge', ['roslaunch', _launch_file(tmp_path, 'multi_map_merge.launch',
-                                                                           MULTI_MAP_MERGE_LAUNCH)], env=_burger())
+    merger = processes.start('multi_map_merge', ['roslaunch', 'turtlebot3_gazebo', 'multi_map_merge.launch'],
+                             env=_burger())
     drove = _probe(processes, 'probe_drive', 'drive', DRIVE_SECONDS, 0.05, 0.6, 6.0, *ROBOTS, timeout=240.0)
     maps = {}
     for name, topic in [(name, '/%s/map' % name) for name in ROBOTS] + [('merged', '/map')]:

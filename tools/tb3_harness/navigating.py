@@ -18,6 +18,8 @@ import time
 from tb3_common.pose2d import normalize_angle as normalize
 from tb3_common.ros.poses import fill_pose, plane_pose
 
+from .waypoints import WORLD_GOALS
+
 RVIZ_COVARIANCE = (0.25, 0.25, (math.pi / 12.0) ** 2)  # rviz's 2D Pose Estimate: x, y, yaw variances
 STATES = {0: 'PENDING', 1: 'ACTIVE', 2: 'PREEMPTED', 3: 'SUCCEEDED', 4: 'ABORTED', 5: 'REJECTED',
           6: 'PREEMPTING', 7: 'RECALLING', 8: 'RECALLED', 9: 'LOST'}
@@ -81,7 +83,6 @@ class Navigation(object):
 
     def _on_cloud(self, message):
         import numpy as np
-        from tb3_common.pose2d import normalize_angle
         poses = np.array([plane_pose(p) for p in message.poses])
         if not len(poses):
             return
@@ -192,9 +193,8 @@ def closest(path, obstacles, footprint):
 
 
 
-#: The demo's and the bench's goals in turtlebot3_world, around and between the pillars, from tb3_world's spawn.
+#: tb3_world's spawn, where the demo's and the bench's goals (waypoints.WORLD_GOALS) start from.
 WORLD_SPAWN = (-2.0, -0.5, 0.0)
-WORLD_GOALS = [(-0.55, -0.55, 0.0), (0.55, 0.55, math.pi / 2), (1.65, -0.55, -math.pi / 2), (-0.55, 1.65, math.pi)]
 BURGER_FOOTPRINT = [(-0.105, -0.105), (-0.105, 0.105), (0.041, 0.105), (0.041, -0.105)]
 #: The explore demo's goals in turtlebot3_house, one in each of four rooms, from tb3_house's spawn:
 #: the small west room, the room inside the north-east one, the north-east room, the south-east room.

@@ -14,9 +14,9 @@ WORLD_LOOP_START = (-2.0, -0.5, 0.0)
 WORLD_LOOP = [(-1.65, -0.5), (-1.65, 1.65), (0.55, 1.65), (1.65, 1.65), (1.65, -0.55), (1.65, -1.65),
               (-0.55, -1.65), (-1.65, -1.65), (-1.65, -0.5), (-2.0, -0.5)]
 
-#: test_navigation's four goals in its order from the same spawn pose, with the corners that keep the
-#: straight legs 0.4 m or more from the pillars: (-0.55, -0.55), (0.55, 0.55), (1.65, -0.55), (-0.55, 1.65).
-WORLD_GOALS = [(-0.55, -0.55), (0.55, 0.55), (1.65, -0.55), (-0.55, 1.65)]
+#: test_navigation's four goals (x, y, yaw) around and between the pillars, in its order from the spawn pose,
+#: and a route through them with the corners that keep the straight legs 0.4 m or more from the pillars.
+WORLD_GOALS = [(-0.55, -0.55, 0.0), (0.55, 0.55, math.pi / 2), (1.65, -0.55, -math.pi / 2), (-0.55, 1.65, math.pi)]
 WORLD_GOALS_ROUTE = [(-0.55, -0.55), (0.55, -0.55), (0.55, 0.55), (1.65, 0.55), (1.65, -0.55), (1.65, 1.65),
                      (-0.55, 1.65)]
 
