@@ -68,6 +68,12 @@ FAKE_LOCALIZATION_LAUNCH = """<launch>
 WORLD_GOAL = (-0.55, -0.55, 0.0)  # test_navigation's first, past the west pillars' row
 XY_TOLERANCE = 0.05               # DWAPlannerROS's, TurtleBot3's
 
+#: The e-manual's multi-robot commands, as the README shows them (the world gets real_time_factor:=0, ours).
+MULTI_WORLD = 'roslaunch turtlebot3_gazebo multi_turtlebot3.launch'
+MULTI_SLAM = {'tb3_0': 'roslaunch turtlebot3_gazebo multi_turtlebot3_slam.launch ns:=tb3_0',
+              'tb3_1': 'roslaunch turtlebot3_gazebo multi_turtlebot3_slam.launch ns:=tb3_1',
+              'tb3_2': 'roslaunch turtlebot3_gazebo multi_turtlebot3_slam.launch ns:=tb3_2'}
+
 # ROBOTIS-GIT/turtlebot3_simulations (noetic), turtlebot3_gazebo/launch/multi_map_merge.launch, as it is (a
 # backslash at a line's end only folds a long line here: the string has it whole).
 DRIVE_SECONDS = 12.0      # sim s each robot turns on a small circle: a look all round from its spawn
@@ -206,11 +212,9 @@ def test_robotis_multi_map_merge_merges_the_three_robots_maps(ros_port, processe
     processes.start_master('roscore', ros_port)
     folder = str(tmp_path)
     # The e-manual's commands, each in a terminal of its own (+ real_time_factor:=0, ours).
-    processes.start('sim', ['roslaunch', 'turtlebot3_gazebo', 'multi_turtlebot3.launch', 'real_time_factor:=0'],
-                    env=_burger())
+    processes.start('sim', MULTI_WORLD.split() + ['real_time_factor:=0'], env=_burger())
     for name in ROBOTS:
-        processes.start('slam_' + name, ['roslaunch', 'turtlebot3_gazebo', 'multi_turtlebot3_slam.launch',
-                                         'ns:=' + name], env=_burger())
+        processes.start('slam_' + name, MULTI_SLAM[name].split(), env=_burger())
     import rosgraph
     master = rosgraph.Master('/test_real_node_names')
     assert wait_until(lambda: all(['/%s/map' % name, 'nav_msgs/OccupancyGrid'] in master.getPublishedTopics('/')

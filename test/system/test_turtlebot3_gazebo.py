@@ -33,10 +33,14 @@ READY = 60.0          # wall s for a launch's first message
 GONE_WITHIN = 2.0     # wall s from Ctrl+C to the end of every node of ours
 #: Our nodes' programs: what must end within GONE_WITHIN (rviz and robot_state_publisher are Debian's).
 OURS = ('tb3_sim_node', 'turtlebot3_drive', 'turtlebot3_fake_node')
-#: ROBOTIS' spawn pose (x_pos, y_pos) of each world launch.
-WORLDS = {'turtlebot3_empty_world': (0.0, 0.0), 'turtlebot3_world': (-2.0, -0.5), 'turtlebot3_house': (-3.0, 1.0),
-          'turtlebot3_stage_1': (0.0, 0.0), 'turtlebot3_stage_2': (0.0, 0.0), 'turtlebot3_stage_3': (0.0, 0.0),
-          'turtlebot3_stage_4': (-0.7, 0.0)}
+#: Each world launch: the e-manual's command (as the README shows it) and ROBOTIS' spawn pose (x_pos, y_pos).
+WORLDS = {'turtlebot3_empty_world': ('roslaunch turtlebot3_gazebo turtlebot3_empty_world.launch', (0.0, 0.0)),
+          'turtlebot3_world': ('roslaunch turtlebot3_gazebo turtlebot3_world.launch', (-2.0, -0.5)),
+          'turtlebot3_house': ('roslaunch turtlebot3_gazebo turtlebot3_house.launch', (-3.0, 1.0)),
+          'turtlebot3_stage_1': ('roslaunch turtlebot3_gazebo turtlebot3_stage_1.launch', (0.0, 0.0)),
+          'turtlebot3_stage_2': ('roslaunch turtlebot3_gazebo turtlebot3_stage_2.launch', (0.0, 0.0)),
+          'turtlebot3_stage_3': ('roslaunch turtlebot3_gazebo turtlebot3_stage_3.launch', (0.0, 0.0)),
+          'turtlebot3_stage_4': ('roslaunch turtlebot3_gazebo turtlebot3_stage_4.launch', (-0.7, 0.0))}
 SPAWN_TOLERANCE = 0.01   # m from ROBOTIS' spawn pose
 WANDER_SECONDS = 60.0    # s of sim time turtlebot3_drive wanders
 WANDER_AT_LEAST = 5.0    # m it must cover meanwhile (about 10 in a run; 13 at a Burger's top speed, all ahead)
@@ -106,9 +110,9 @@ def colour_pixels(image, colour, tolerance):
 
 def test_every_world_launch_spawns_the_robot_where_robotis_does(master, launches, processes):
     truth = Echo(processes, '/base_pose_ground_truth')
-    for name, spawn in WORLDS.items():
+    for name, (command, spawn) in WORLDS.items():
         mark = truth.count()
-        world = launches(name, 'roslaunch turtlebot3_gazebo %s.launch' % name)
+        world = launches(name, command)
         first = truth.after(mark, READY)
         assert first is not None, 'no ground truth from %s within %.0f s; %s' % (name, READY, world.describe())
         pose = poses(truth, [first])[0]
