@@ -28,6 +28,7 @@ import rospkg
 
 from tb3_common.map_files import load_map
 from tb3_harness.map_quality import measure
+from tb3_harness.screen import save_png, screenshot, start_xvfb
 from tb3_sim_nav.world_file import load_world
 from tb3_system_utils import ROBOTS, wait_until
 
@@ -65,6 +66,7 @@ FAKE_LOCALIZATION_LAUNCH = """<launch>
   <include file="$(find tb3_sim_nav)/launch/move_base.launch"/>
 </launch>
 """
+SHOTS = os.path.join(rospkg.get_ros_home(), 'test_results', 'tb3_sim_nav', 'real_node_names')
 WORLD_GOAL = (-0.55, -0.55, 0.0)  # test_navigation's first, past the west pillars' row
 XY_TOLERANCE = 0.05               # DWAPlannerROS's, TurtleBot3's
 
@@ -73,9 +75,10 @@ MULTI_WORLD = 'roslaunch turtlebot3_gazebo multi_turtlebot3.launch'
 MULTI_SLAM = {'tb3_0': 'roslaunch turtlebot3_gazebo multi_turtlebot3_slam.launch ns:=tb3_0',
               'tb3_1': 'roslaunch turtlebot3_gazebo multi_turtlebot3_slam.launch ns:=tb3_1',
               'tb3_2': 'roslaunch turtlebot3_gazebo multi_turtlebot3_slam.launch ns:=tb3_2'}
-
-# ROBOTIS-GIT/turtlebot3_simulations (noetic), turtlebot3_gazebo/launch/multi_map_merge.launch, as it is (a
-# backslash at a line's end only folds a long line here: the string has it whole).
+MULTI_MERGE = 'roslaunch turtlebot3_gazebo multi_map_merge.launch'
+MULTI_RVIZ = 'rosrun rviz rviz -d `rospack find turtlebot3_gazebo`/rviz/multi_turtlebot3_slam.rviz'
+WALL = (14, 14, 14)       # rviz's "map" scheme: an occupied cell
+FLOOR = (214, 221, 220)   # a free cell of the merged map under a free cell of a robot's own (both drawn at 0.7)
 DRIVE_SECONDS = 12.0      # sim s each robot turns on a small circle: a look all round from its spawn
 KNOWN_IN_MERGED = 0.97    # share of each robot's known cells the merged map knows too
 NEAR_SURFACE = 0.95       # share of the merged map's occupied cells within 0.10 m of the house's surfaces
@@ -219,9 +222,23 @@ def test_robotis_multi_map_merge_merges_the_three_robots_maps(ros_port, processe
     master = rosgraph.Master('/test_real_node_names')
     assert wait_until(lambda: all(['/%s/map' % name, 'nav_msgs/OccupancyGrid'] in master.getPublishedTopics('/')
                                   for name in ROBOTS), 120.0), 'no map topic of each robot'
-    merger = processes.start('multi_map_merge', ['roslaunch', 'turtlebot3_gazebo', 'multi_map_merge.launch'],
-                             env=_burger())
+    merger = processes.start('multi_map_merge', MULTI_MERGE.split(), env=_burger())
     drove = _probe(processes, 'probe_drive', 'drive', DRIVE_SECONDS, 0.05, 0.6, 6.0, *ROBOTS, timeout=240.0)
+    # rviz as the e-manual starts it (backticks, through bash), on a screen of the test's own: the merged map
+    # and the robots' own maps are drawn.
+    xvfb, display = start_xvfb()
+    processes.add(xvfb, server=True)
+    processes.start('rviz', ['bash', '-c', MULTI_RVIZ], env=_burger(DISPLAY=display))
+    drawn = []
+
+    def maps_drawn():
+        image = screenshot(display).astype(int)
+        drawn[:] = [image] + [int((np.abs(image - np.array(colour)).max(axis=2) <= 8).sum()) for colour in (WALL, FLOOR)]
+        return drawn[1] > 500 and drawn[2] > 5000
+    assert wait_until(maps_drawn, 120.0, poll=1.0), 'rviz draws no map: %s wall and floor pixels' % drawn[1:]
+    os.makedirs(SHOTS, exist_ok=True)
+    save_png(drawn[0].astype(np.uint8), os.path.join(SHOTS, 'multi_turtlebot3_slam.png'))
+    print('MEASURED rviz with multi_turtlebot3_slam.rviz: %d wall and %d floor pixels' % tuple(drawn[1:]))
     maps = {}
     for name, topic in [(name, '/%s/map' % name) for name in ROBOTS] + [('merged', '/map')]:
         saver = processes.start('saver_' + name, ['rosrun', 'map_server', 'map_saver', '-f',

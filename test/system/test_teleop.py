@@ -30,11 +30,11 @@ import pytest
 from tb3_system_utils import Echo, alive, harness, poses, run, wait_until
 
 TELEOP = ['rosrun', 'tb3_sim_nav', 'tb3_teleop_key']
-MULTI = ['roslaunch', 'tb3_sim_bringup', 'multi_tb3.launch']
+MULTI = ['roslaunch', 'turtlebot3_gazebo', 'multi_turtlebot3.launch']  # the e-manual's, for several robots
 ROBOTIS = ['roslaunch', 'turtlebot3_teleop', 'turtlebot3_teleop_key.launch']
 #: ROBOTIS' e-manual, typed as it is there.
 EMANUAL = ['bash', '-c', 'export TURTLEBOT3_MODEL=burger && roslaunch turtlebot3_teleop turtlebot3_teleop_key.launch']
-NAMESPACED = 'ROS_NAMESPACE=tb3_0 rosrun tb3_sim_nav tb3_teleop_key'  # the README's, for one of several
+NAMESPACED = 'ROS_NAMESPACE=tb3_0 rosrun turtlebot3_teleop turtlebot3_teleop_key'  # the e-manual's, for one of them
 LIMITS = {'burger': (0.22, 2.84), 'waffle': (0.26, 1.82), 'waffle_pi': (0.26, 1.82)}
 LINEAR_HALF_STEP = 0.005   # m/s: the profile's change per message
 ANGULAR_HALF_STEP = 0.05   # rad/s
@@ -386,7 +386,7 @@ def test_a_killed_roslaunch_leaves_no_teleop_behind(master, processes, tmp_path,
 
 
 def test_in_a_namespace_it_drives_one_robot_of_three(master, processes, tmp_path, monkeypatch):
-    """multi_tb3.launch, then the README's `ROS_NAMESPACE=tb3_0 rosrun tb3_sim_nav tb3_teleop_key`:
+    """multi_turtlebot3.launch, then the e-manual's `ROS_NAMESPACE=tb3_0 rosrun turtlebot3_teleop turtlebot3_teleop_key`:
     tb3_0 (facing +y) drives ahead on /tb3_0/cmd_vel, tb3_1 does not move."""
     monkeypatch.setenv('TURTLEBOT3_MODEL', 'burger')
     sim = processes.start('sim', MULTI)
