@@ -7,13 +7,12 @@ import math
 import numpy as np
 import pytest
 
+from tb3_common.pose2d import compose, normalize_angle
+from tb3_harness.nav_sim import Lidar, Unicycle, costmaps, footprint_clearance, odom_of, update_costmaps, world_cut
 from tb3_navigation.controller import STALLED, Command, DwaConfig, DwaController, dwa_config
 from tb3_navigation.costmap import BURGER_FOOTPRINT, Costmap, CostmapConfig
 from tb3_navigation.planner import GlobalPlanner
-from tb3_common.pose2d import compose, normalize_angle
 from tb3_navigation.trajectory_scoring import velocity_samples
-
-from tb3_harness.nav_sim import Lidar, Unicycle, costmaps, footprint_clearance, odom_of, update_costmaps, world_cut
 
 PERIOD = 0.1  # s: controller_frequency 10
 CLEARANCE = 0.09  # m: the footprint never nearer to an obstacle
@@ -234,3 +233,25 @@ def test_turtlebot3_values_and_validation():
         DwaConfig(acc_lim_x=float('nan'))
     with pytest.raises(ValueError, match='model'):
         dwa_config('turtlebot2')
+
+
+def test_new_parameters_take_effect_at_the_next_command_and_the_followed_plan_is_given():
+    _, controller = open_field()
+    plan = straight_plan()
+    assert controller.compute((0.0, 0.0, 0.0), (0.2, 0.0), plan).v == pytest.approx(0.22)
+    controller.configure(dwa_config(max_vel_x=0.15))
+    command = controller.compute((0.0, 0.0, 0.0), (0.2, 0.0), plan)
+    assert command.v == pytest.approx(0.15) and controller.scorer.config.max_vel_x == 0.15
+    assert command.followed[0] == pytest.approx(plan[0]) and len(command.followed) == len(plan)
+
+
+def test_without_forward_point_scoring_the_turn_in_place_faces_the_goal():
+    """TrajectoryPlannerROS's critics score a trajectory's end alone, so every turn in place costs the same;
+    its heading_lookahead (here forward_point_distance) picks the one facing the goal: a plan behind the
+    robot to its left makes it turn left, one to its right, right (the first sampled, right, would win)."""
+    config = DwaConfig(forward_point_scoring=False, min_vel_x=0.0, min_vel_trans=0.1, min_vel_theta=0.1)
+    for side in (1.0, -1.0):
+        _, controller = open_field(config)
+        plan = straight_plan(1.0, side * 2.5)
+        command = controller.compute((0.0, 0.0, 0.0), (0.0, 0.0), plan)
+        assert command.ok and command.v == 0.0 and math.copysign(1.0, command.w) == side

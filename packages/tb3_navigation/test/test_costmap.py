@@ -6,14 +6,23 @@ import math
 import numpy as np
 import pytest
 
-from tb3_navigation.costmap import (BURGER_FOOTPRINT, FREE_SPACE, INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE,
-                                    NO_INFORMATION, WAFFLE_FOOTPRINT, Costmap, CostmapConfig, footprint_radii,
-                                    occupancy_values)
 from tb3_common.grid import Grid
 from tb3_common.pose2d import compose
-from tb3_sim_nav.world_file import Obstacle
-
 from tb3_harness.nav_sim import SCAN_POSE, Lidar
+from tb3_navigation.costmap import (
+    BURGER_FOOTPRINT,
+    FREE_SPACE,
+    INSCRIBED_INFLATED_OBSTACLE,
+    LETHAL_OBSTACLE,
+    NO_INFORMATION,
+    WAFFLE_FOOTPRINT,
+    Costmap,
+    CostmapConfig,
+    circle_footprint,
+    footprint_radii,
+    occupancy_values,
+)
+from tb3_sim_nav.world_file import Obstacle
 
 RESOLUTION = 0.05
 
@@ -255,8 +264,8 @@ def test_config_validation_names_the_parameter():
 # --- the tests' lidar: world_map.ray_cast ---------------------------------------------------
 
 def test_ray_cast_ends_on_an_outline_and_misses_cross_nothing():
-    from tb3_sim_nav import world_map
     from tb3_harness.nav_sim import world_cut
+    from tb3_sim_nav import world_map
     obstacles = world_cut() + [box(-1.6, -1.6, 0.3, 0.3, 0.4)]
     rng = np.random.default_rng(11)
     for origin in rng.uniform(-2.0, 2.0, (12, 2)):
@@ -281,3 +290,53 @@ def test_ray_cast_along_a_box_s_axes():
     assert world_map.ray_cast([ahead], (0.0, 0.0), [0.0])[0] == pytest.approx(0.95)
     assert world_map.ray_cast([ahead], (1.0, -1.0), [math.pi / 2])[0] == pytest.approx(0.8)
     assert world_map.ray_cast([ahead], (0.0, 0.0), [0.0], max_range=0.9)[0] == math.inf
+
+
+# --- what move_base's parameters add: robot_radius, observation sources, live inflation ----------
+
+class Source(object):
+    """An observation source as move_base's costmap_params makes one."""
+
+    def __init__(self, marking=True, clearing=True, obstacle_range=3.0, raytrace_range=3.5, inf_is_valid=False):
+        self.marking, self.clearing, self.inf_is_valid = marking, clearing, inf_is_valid
+        self.obstacle_range, self.raytrace_range = obstacle_range, raytrace_range
+
+
+def test_robot_radius_is_costmap_2ds_16_corner_polygon():
+    corners = np.array(circle_footprint(0.2))
+    assert corners.shape == (16, 2) and np.allclose(np.hypot(*corners.T), 0.2)
+    assert np.allclose(corners[::4], [(0.2, 0.0), (0.0, 0.2), (-0.2, 0.0), (0.0, -0.2)])
+    inscribed, circumscribed = footprint_radii(corners)
+    assert inscribed == pytest.approx(0.2 * math.cos(math.pi / 16)) and circumscribed == pytest.approx(0.2)
+
+
+def test_a_source_marks_and_clears_only_as_it_says():
+    grid, data = empty_map(width=160, height=160, origin=(-4.0, -4.0, 0.0))
+    seen = [box(1.5, 0.0, 0.3, 0.3)]
+    costmap = Costmap(grid, CostmapConfig(inflation_radius=0.0), static=data)
+    scan = Lidar(seen, 1).scan((0.0, 0.0, 0.0))
+    costmap.update((0.0, 0.0, 0.0), scan, SCAN_POSE, Source(marking=False))
+    assert not lethal_near(costmap, (1.35, 0.0))
+    costmap.update((0.0, 0.0, 0.0), scan, SCAN_POSE, Source(obstacle_range=1.0))  # the box lies beyond
+    assert not lethal_near(costmap, (1.35, 0.0))
+    costmap.update((0.0, 0.0, 0.0), scan, SCAN_POSE, Source())
+    assert lethal_near(costmap, (1.35, 0.0))
+    emptied = Lidar([box(2.5, 0.0, 0.1, 3.0)], 2).scan((0.0, 0.0, 0.0))
+    costmap.update((0.0, 0.0, 0.0), emptied, SCAN_POSE, Source(clearing=False, marking=False))
+    assert lethal_near(costmap, (1.35, 0.0))  # not cleared: the beams through it do not clear
+    costmap.update((0.0, 0.0, 0.0), emptied, SCAN_POSE, Source(marking=False))
+    assert not lethal_near(costmap, (1.35, 0.0), 0.1)
+
+
+def test_inflation_changes_on_a_running_costmap_and_inflate_unknown():
+    grid, data = empty_map()
+    data[40, 40] = 100
+    data[40, 50:] = -1  # unknown cells east of the wall cell
+    config = CostmapConfig(track_unknown_space=True, inflation_radius=0.5)
+    costmap = Costmap(grid, config, static=data)
+    assert costmap.costs[40, 45] > 0 and costmap.costs[40, 52] == NO_INFORMATION
+    costmap.reconfigure(config.replace(inflation_radius=0.2))
+    assert costmap.costs[40, 45] == 0 and costmap.costs[40, 43] > 0
+    costmap.reconfigure(config.replace(inflate_unknown=True))
+    assert FREE_SPACE < costmap.costs[40, 50] < INSCRIBED_INFLATED_OBSTACLE  # 0.5 m from the wall: inflated
+    assert costmap.costs[40, 52] == NO_INFORMATION                          # 0.6 m, beyond 0.5 m: unknown

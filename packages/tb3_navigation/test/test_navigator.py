@@ -6,15 +6,25 @@ import math
 import numpy as np
 import pytest
 
+from tb3_common.pose2d import compose, quaternion_of_yaw
+from tb3_harness.nav_sim import MAP_IN_ODOM, Lidar, Unicycle, costmaps, footprint_clearance, update_costmaps, world_cut
 from tb3_navigation.controller import Command, DwaController, dwa_config
 from tb3_navigation.costmap import BURGER_FOOTPRINT
-from tb3_navigation.navigator import (ABORTED, CLEARING, CONTROLLING, PLANNING, PREEMPTED, STOP, SUCCEEDED,
-                                      Navigator, NavigatorConfig, RotateRecoveryConfig, goal_error)
+from tb3_navigation.navigator import (
+    ABORTED,
+    CLEARING,
+    CONTROLLING,
+    PLANNING,
+    PREEMPTED,
+    STOP,
+    SUCCEEDED,
+    Navigator,
+    NavigatorConfig,
+    RotateRecoveryConfig,
+    goal_error,
+)
 from tb3_navigation.planner import GlobalPlanner
-from tb3_common.pose2d import compose, quaternion_of_yaw
 from tb3_sim_nav.world_file import Obstacle
-
-from tb3_harness.nav_sim import MAP_IN_ODOM, Lidar, Unicycle, costmaps, footprint_clearance, update_costmaps, world_cut
 
 PERIOD = 0.1
 UP = quaternion_of_yaw(0.0)
@@ -203,6 +213,15 @@ def test_rotate_recovery_turns_a_full_turn_left_within_its_limits():
     assert run.navigator.state == PLANNING
 
 
+def test_rotate_recovery_takes_the_limits_it_is_given():
+    run = Run(planner=FakePlanner(works=False))
+    run.navigator.rotation = RotateRecoveryConfig(max_vel_theta=0.6, min_in_place_vel_theta=0.3)
+    run.goal()
+    speeds = [step.cmd[1] for step in (run.step() for _ in range(400))
+              if step.state == CLEARING and step.cmd not in (None, STOP)]
+    assert speeds and min(speeds) >= 0.3 and max(speeds) <= 0.6
+
+
 def test_rotation_ends_when_the_footprint_would_hit_something():
     run = Run(planner=FakePlanner(works=False))
     run.local_costmap.blocked = True
@@ -289,6 +308,15 @@ def test_make_plan_and_clear_costmaps_services():
     assert run.global_costmap.resets == run.local_costmap.resets == 1
 
 
+def test_make_plan_adds_an_unreachable_goal_only_if_asked():
+    run = Run(planner=FakePlanner(works=False))
+    run.planner.make_plan = lambda costmap, start, goal, tolerance=None: [tuple(start)] if tolerance else None
+    assert run.navigator.make_plan((0.0, 0.0, 0.0), (1.0, 1.0, 0.0), tolerance=0.5) == [(0.0, 0.0, 0.0),
+                                                                                       (1.0, 1.0, 0.0)]
+    assert run.navigator.make_plan((0.0, 0.0, 0.0), (1.0, 1.0, 0.0), 0.5, add_unreachable_goal=False) == \
+        [(0.0, 0.0, 0.0)]
+
+
 def test_config_validation_names_the_parameter():
     with pytest.raises(ValueError, match='planner_patience'):
         NavigatorConfig(planner_patience=-1.0)
@@ -298,7 +326,7 @@ def test_config_validation_names_the_parameter():
         NavigatorConfig(recovery_behaviors=('conservative_reset', 'dance'))
     with pytest.raises(ValueError, match='global_frame'):
         NavigatorConfig(global_frame='')
-    with pytest.raises(ValueError, match='rotate_recovery: sim_granularity'):
+    with pytest.raises(ValueError, match='~sim_granularity = 0.0: must be > 0'):
         RotateRecoveryConfig(sim_granularity=0.0)
 
 

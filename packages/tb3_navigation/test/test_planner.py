@@ -6,12 +6,11 @@ import time
 import numpy as np
 import pytest
 
-from tb3_navigation.costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION, Costmap, CostmapConfig
 from tb3_common.grid import Grid
-from tb3_navigation.planner import GlobalPlanner, PlannerConfig, plan_length
-from tb3_sim_nav import world_map
-
 from tb3_harness.nav_sim import world_cut
+from tb3_navigation.costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION, Costmap, CostmapConfig
+from tb3_navigation.planner import GlobalPlanner, PlannerConfig, orient, plan_length
+from tb3_sim_nav import world_map
 
 PILLARS = [(x, y) for x in (-1.1, 0.0, 1.1) for y in (-1.1, 0.0, 1.1)]
 PILLAR_RADIUS = 0.15
@@ -206,3 +205,29 @@ def test_a_house_sized_map_plans_across_and_the_time_is_reported(capsys):
     with capsys.disabled():
         print('\n400 x 260 house plan, %.1f m: median %.0f ms wall, %.0f ms CPU (max %.0f ms wall)'
               % (plan_length(plan), 1e3 * np.median(walls), 1e3 * np.median(cpu), 1e3 * max(walls)))
+
+
+def test_global_planners_step_costs_with_its_lethal_cost():
+    costs = np.array([[0, 100, 251, 252, 253, 254, NO_INFORMATION]], dtype=np.uint8)
+    navfn = GlobalPlanner().step_costs(costs)[0]
+    assert navfn[:4] == pytest.approx([50.0, 130.0, 250.8, 251.6]) and np.all(np.isinf(navfn[4:6]))
+    assert navfn[6] == 253.0  # unknown, allowed: navfn's COST_OBS - 1
+    # global_planner's getCost: factor 3 from 50, capped one below lethal_cost, the cell below it at lethal_cost.
+    gp = GlobalPlanner(PlannerConfig(cost_factor=3.0, lethal_cost=253)).step_costs(costs)[0]
+    assert gp[0] == 50.0 and gp[1] == 252.0 and gp[3] == 253.0 and np.all(np.isinf(gp[4:6])) and gp[6] == 252.0
+    with pytest.raises(ValueError, match='~neutral_cost = 200'):
+        PlannerConfig(neutral_cost=200, lethal_cost=150)
+
+
+def test_orientation_modes_as_global_planners_orientation_filter():
+    points = [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (2.0, 1.0), (2.0, 2.0)]
+    yaws = lambda mode, **kwargs: [pose[2] for pose in orient(points, 1.0, mode, **kwargs)]  # noqa: E731
+    assert yaws(1) == pytest.approx([0.0, 0.0, math.pi / 2, math.pi / 2, 1.0])        # each faces the next
+    assert yaws(1, window=1) == pytest.approx([0.0, 0.0, math.pi / 4, math.pi / 2, 1.0])  # from before to after
+    assert yaws(0) == pytest.approx([0.0, 0.0, 0.0, 0.0, 1.0])
+    assert np.abs(yaws(4)[:2]) == pytest.approx([math.pi, math.pi]) and yaws(5)[0] == pytest.approx(-math.pi / 2)
+    assert abs(yaws(6)[2]) == pytest.approx(math.pi)
+    assert yaws(2, start_yaw=-0.6) == pytest.approx([-0.6, -0.2, 0.2, 0.6, 1.0])  # start to goal, evenly
+    # Forward, then from the third last pose back to the last turn of more than 0.35 rad, interpolated to
+    # the goal's heading (here the turn is at the third last pose itself).
+    assert yaws(3, start_yaw=-0.6) == pytest.approx([-0.6, 0.0, math.pi / 2, (math.pi / 2 + 1.0) / 2, 1.0])

@@ -11,26 +11,36 @@ transform_tolerance (re-sent with each scan, as amcl does). The pose is
 saved to ~initial_pose_* every 1 / save_pose_rate s, so a restarted node
 resumes there, as amcl's does. Each scan is handled in its callback, start to
 end, so a simulator in lockstep waits for it.
+
+Parameters as amcl reads them (amcl.config); AMCL.cfg's that this node
+honours are live at `/amcl` through dynamic_reconfigure: a change reaches
+the filter at its next update; one of the laser model's makes the filter
+anew around its estimate, as amcl makes it anew on any change (here the
+particles stay otherwise). A bad value is refused with the reason, logged,
+and nothing changes.
 """
-import dataclasses
 import math
 import threading
 
 import numpy as np
 import rospy
+from dynamic_reconfigure.server import Server
 from geometry_msgs.msg import Pose, PoseArray, PoseWithCovarianceStamped
 from nav_msgs.msg import OccupancyGrid
 from nav_msgs.srv import GetMap, SetMap, SetMapResponse
 from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty, EmptyResponse
 
-from tb3_navigation.amcl_config import AmclConfig
-from tb3_navigation.localization import Amcl, covariance_3x3, covariance_6x6
+from tb3_common.params import ParameterError
 from tb3_common.pose2d import quaternion_of_yaw, yaw_of_quaternion
-from tb3_navigation.scan import Scan
 from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import Frames, namespaced
 from tb3_common.ros.map_messages import grid_of_message
+from tb3_navigation.amcl_config import AmclConfig
+from tb3_navigation.localization import Amcl, covariance_3x3, covariance_6x6
+from tb3_navigation.scan import Scan
+
+from .config import AmclNodeConfig, amcl_values, changed, live_fields, node_values, reconfigured, unhonoured
 
 NODE = 'amcl'
 FRAMES = {'odom_frame_id': 'odom', 'base_frame_id': 'base_footprint', 'global_frame_id': 'map'}
@@ -48,16 +58,16 @@ class AmclNode(object):
 
     def __init__(self, life):
         namespace = rospy.get_namespace()
-        frames = dict((name, namespaced(frame, namespace)) for name, frame in FRAMES.items()
-                      if not rospy.has_param('~' + name))
-        self.config = params.read_or_exit(NODE, AmclConfig, overrides=frames)
-        self.use_map_topic = bool(rospy.get_param('~use_map_topic', False))
-        self.save_pose_rate = float(rospy.get_param('~save_pose_rate', 0.5))
-        seed = rospy.get_param('~seed', -1)
-        self.seed = None if seed < 0 else int(seed)
+        tree = rospy.get_param('~', {})
+        frames = dict((name, namespaced(frame, namespace)) for name, frame in FRAMES.items())
+        self.config = params.read_or_exit(NODE, AmclConfig, overrides=amcl_values(tree, frames),
+                                          unhonoured=unhonoured(tree))
+        self.node_config = params.read_or_exit(NODE, AmclNodeConfig, overrides=node_values(tree))
+        self.seed = None if self.node_config.seed < 0 else self.node_config.seed
         self.frames = Frames(NODE)
         self._lock = threading.Lock()  # the filter, between the scan callback, initialpose and the services
         self.filter = None
+        self._map = None  # (grid, values) of the filter's map
         self._sensors = {}
         self._transform = None  # map -> odom of the last update
         self._last_cloud = self._last_save = None
@@ -67,11 +77,41 @@ class AmclNode(object):
         rospy.Service('request_nomotion_update', Empty, self._on_nomotion_update)
         rospy.Service('set_map', SetMap, self._on_set_map)
         rospy.Subscriber('initialpose', PoseWithCovarianceStamped, life.callback(self._on_initial_pose), queue_size=2)
-        if self.use_map_topic:
-            rospy.Subscriber('map', OccupancyGrid, life.callback(self._on_map), queue_size=1)
+        if self.node_config.use_map_topic:
+            rospy.Subscriber('map', OccupancyGrid, life.callback(self._on_map_topic), queue_size=1)
         else:
             threading.Thread(target=self._request_map, name='static_map', daemon=True).start()
         rospy.Subscriber('scan', LaserScan, life.callback(self._on_scan), queue_size=1)
+        self._live_server = self._serve()
+
+    # --- live parameters (dynamic_reconfigure at /amcl) -----------------------------------------
+    def _serve(self):
+        from .cfg import AMCLConfig  # made by catkin from cfg/AMCL.cfg
+        for config_class, field in live_fields():
+            config = self.config if config_class is AmclConfig else self.node_config
+            rospy.set_param('~' + field.name, getattr(config, field.name))
+        return Server(AMCLConfig, self._on_reconfigure)
+
+    def _on_reconfigure(self, values, _level):
+        try:
+            with self._lock:
+                config, node_config, changes, model = changed(self.config, self.node_config, values)
+                self._reconfigure(config, node_config, model)
+            if changes:
+                rospy.loginfo('%s: dynamic_reconfigure: %s%s', NODE, ', '.join(
+                    '%s = %r' % change for change in sorted(changes.items())),
+                    ' (the filter made anew around its estimate)' if model else '')
+        except ParameterError as error:
+            rospy.logwarn('%s: dynamic_reconfigure refused: %s; nothing changed', NODE, error)
+        for config_class, field in live_fields():
+            values[field.name] = getattr(self.config if config_class is AmclConfig else self.node_config, field.name)
+        return values
+
+    def _reconfigure(self, config, node_config, model):
+        """Takes new configs (the lock held): see amcl.config.reconfigured."""
+        if self.filter is not None:
+            self.filter = reconfigured(self.filter, config, model, self._map[0], self._map[1], self.seed)
+        self.config, self.node_config = config, node_config
 
     # --- the map ------------------------------------------------------------------
     def _request_map(self):
@@ -84,12 +124,21 @@ class AmclNode(object):
             except (rospy.ROSException, rospy.ServiceException) as error:
                 self.frames.warn('static_map', 'no map yet from static_map (%s): start map_server', error)
 
+    def _on_map_topic(self, message):
+        if self.node_config.first_map_only and self._map is not None:
+            rospy.loginfo('%s: a new map on %s ignored (first_map_only)', NODE, rospy.resolve_name('map'))
+            return
+        self._on_map(message)
+
     def _on_map(self, message, pose=None, covariance=None):
         grid, values, _ = grid_of_message(message)
         with self._lock:
+            self._map = (grid, values)
             self.filter = Amcl(self.config, grid, values, self.seed)
             if pose is not None:
                 self.filter.initialise(pose, covariance)
+                if self.node_config.force_update_after_set_map:
+                    self.filter.request_nomotion_update()
             self._transform = None
         rospy.loginfo('%s: map of %d x %d cells at %.3f m/cell; particles around (%.2f, %.2f, %.2f)', NODE,
                       grid.width, grid.height, grid.resolution, *self.filter.estimate().pose)
@@ -111,7 +160,7 @@ class AmclNode(object):
         with self._lock:
             if self.filter is None:
                 rospy.logwarn('%s: no map yet: the initial pose waits for one', NODE)
-                self.config = dataclasses.replace(self.config, initial_pose_x=values[0], initial_pose_y=values[1],
+                self.config = self.config.replace(initial_pose_x=values[0], initial_pose_y=values[1],
                                                   initial_pose_a=values[2])
                 return
             try:
@@ -119,6 +168,8 @@ class AmclNode(object):
             except ValueError as error:
                 rospy.logwarn('%s: ignoring an initial pose: %s', NODE, error)
                 return
+            if self.node_config.force_update_after_initialpose:
+                self.filter.request_nomotion_update()
         rospy.loginfo('%s: initial pose (%.3f, %.3f, %.3f) with standard deviations %.2f m, %.2f m, %.2f rad', NODE,
                       values[0], values[1], values[2], *np.sqrt(np.maximum(np.diag(covariance), 0.0)))
 
@@ -194,14 +245,15 @@ class AmclNode(object):
 
     def _save_pose(self, estimate, stamp):
         """amcl's save_pose_rate: the pose on the parameter server, where a restarted node starts."""
-        if self.save_pose_rate <= 0 or (self._last_save is not None
-                                        and (stamp - self._last_save).to_sec() < 1.0 / self.save_pose_rate):
+        rate = self.node_config.save_pose_rate
+        if rate <= 0 or (self._last_save is not None and (stamp - self._last_save).to_sec() < 1.0 / rate):
             return
         self._last_save = stamp
         x, y, yaw = estimate.pose
+        covariance = estimate.covariance
         for name, value in (('initial_pose_x', x), ('initial_pose_y', y), ('initial_pose_a', yaw),
-                            ('initial_cov_xx', estimate.covariance[0][0]), ('initial_cov_yy', estimate.covariance[1][1]),
-                            ('initial_cov_aa', estimate.covariance[2][2])):
+                            ('initial_cov_xx', covariance[0][0]), ('initial_cov_yy', covariance[1][1]),
+                            ('initial_cov_aa', covariance[2][2])):
             rospy.set_param('~' + name, float(value))
 
 

@@ -27,10 +27,11 @@ Poses, plans and the costmap are in one frame (the local costmap's, odom);
 velocities in the robot's. Every command is finite and within the limits.
 """
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from tb3_common.params import Checked, fail, non_negative, number, parameter, positive
 from tb3_common.pose2d import normalize_angle
 from tb3_navigation.trajectory_scoring import GOAL_ZONE, TrajectoryScorer, velocity_samples
 
@@ -51,63 +52,64 @@ PASSED = 0.5
 STALLED = 50
 
 
-@dataclass(frozen=True)
-class DwaConfig:
-    """dwa_local_planner's parameters: dwa_local_planner_params_burger.yaml (noetic), and
-    dwa_local_planner's defaults for those it does not set."""
-    max_vel_x: float = 0.22  # m/s
-    min_vel_x: float = -0.22  # m/s: negative drives backwards (move_forward_only: 0)
-    max_vel_y: float = 0.0  # a differential base: 0
-    min_vel_y: float = 0.0  # a differential base: 0
-    max_vel_trans: float = 0.22  # m/s
-    min_vel_trans: float = 0.11  # m/s: slower drives must turn at least min_vel_theta
-    max_vel_theta: float = 2.75  # rad/s
-    min_vel_theta: float = 1.37  # rad/s: the slowest turn in place
-    acc_lim_x: float = 2.5  # m/s^2
-    acc_lim_y: float = 0.0  # a differential base: 0
-    acc_lim_theta: float = 3.2  # rad/s^2
-    xy_goal_tolerance: float = 0.05  # m: the goal is reached this near (the controller aims at 0.3 of it)
-    yaw_goal_tolerance: float = 0.17  # rad: and turned this near (aims at 0.3 of it)
-    latch_xy_goal_tolerance: bool = False  # true: once near enough, only turn
-    sim_time: float = 1.5  # s each sampled trajectory is simulated
-    sim_granularity: float = 0.025  # m between checks along a trajectory
-    angular_sim_granularity: float = 0.1  # rad between checks along a turn
-    vx_samples: int = 20  # speeds sampled
-    vy_samples: int = 0  # a differential base: 0
-    vth_samples: int = 40  # turn rates sampled
-    controller_frequency: float = 10.0  # Hz: the window of reachable speeds is one period of the accelerations
-    path_distance_bias: float = 32.0  # weight of staying on the global plan
-    goal_distance_bias: float = 20.0  # weight of getting to the local goal
-    occdist_scale: float = 0.02  # weight of keeping off obstacles
-    obstacle_clearance: float = 0.12  # m (ours): trajectories keep this far from obstacles whenever one can
-    forward_point_distance: float = 0.325  # m: the point ahead scored too
-    stop_time_buffer: float = 0.2  # s: a trajectory must stop this long before an obstacle
-    scaling_speed: float = 0.25  # m/s: above it the footprint is scaled up
-    max_scaling_factor: float = 0.2  # up to 1 + this
-    oscillation_reset_dist: float = 0.05  # m: moving this far resets the oscillation flags
-    oscillation_reset_angle: float = 0.2  # rad: turning this far resets them too
-    trans_stopped_vel: float = 0.1  # m/s: slower counts as stopped
-    theta_stopped_vel: float = 0.1  # rad/s: slower counts as stopped
+def _no_sideways(value):
+    return None if value == 0 else 'must be 0: a TurtleBot3 is a differential base (no sideways speed)'
 
-    def __post_init__(self):
-        for field in fields(self):
-            value = getattr(self, field.name)
-            if field.type is bool:
-                continue
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise ValueError('%s must be a finite number, not %r' % (field.name, value))
-            if field.name not in ('min_vel_x', 'min_vel_y') and value < 0:
-                raise ValueError('%s must be >= 0, not %r' % (field.name, value))
-        for name in ('max_vel_y', 'min_vel_y', 'acc_lim_y', 'vy_samples'):
-            if getattr(self, name) != 0:
-                raise ValueError('%s must be 0 (this controller drives a differential base), not %r'
-                                 % (name, getattr(self, name)))
+
+@dataclass(frozen=True)
+class DwaConfig(Checked):
+    """dwa_local_planner's parameters: dwa_local_planner_params_burger.yaml (noetic), and
+    dwa_local_planner's defaults for those it does not set. `live` ones are DWAPlanner.cfg's:
+    dynamic_reconfigure changes them on a running node."""
+    max_vel_x: float = parameter(0.22, 'm/s', non_negative, 'm/s', live=True)
+    min_vel_x: float = parameter(-0.22, 'm/s: negative drives backwards (move_forward_only: 0)', None, 'm/s',
+                                 live=True)
+    max_vel_y: float = parameter(0.0, 'a differential base: 0', _no_sideways, 'm/s', live=True)
+    min_vel_y: float = parameter(0.0, 'a differential base: 0', _no_sideways, 'm/s', live=True)
+    max_vel_trans: float = parameter(0.22, 'm/s', positive, 'm/s', live=True)
+    min_vel_trans: float = parameter(0.11, 'm/s: slower drives must turn at least min_vel_theta', non_negative, 'm/s',
+                                     live=True)
+    max_vel_theta: float = parameter(2.75, 'rad/s', positive, 'rad/s', live=True)
+    min_vel_theta: float = parameter(1.37, 'rad/s: the slowest turn in place', non_negative, 'rad/s', live=True)
+    acc_lim_x: float = parameter(2.5, 'm/s^2', non_negative, 'm/s^2', live=True)
+    acc_lim_y: float = parameter(0.0, 'unused: a differential base has no y speed', non_negative, 'm/s^2', live=True)
+    acc_lim_theta: float = parameter(3.2, 'rad/s^2', non_negative, 'rad/s^2', live=True)
+    xy_goal_tolerance: float = parameter(0.05, 'm: the goal is reached this near (the controller aims at 0.3 of it)',
+                                         non_negative, 'm', live=True)
+    yaw_goal_tolerance: float = parameter(0.17, 'rad: and turned this near (aims at 0.3 of it)', non_negative, 'rad',
+                                          live=True)
+    latch_xy_goal_tolerance: bool = parameter(False, 'true: once near enough, only turn')
+    sim_time: float = parameter(1.5, 's each sampled trajectory is simulated', positive, 's', live=True)
+    sim_granularity: float = parameter(0.025, 'm between checks along a trajectory', positive, 'm', live=True)
+    angular_sim_granularity: float = parameter(0.1, 'rad between checks along a turn', positive, 'rad', live=True)
+    vx_samples: int = parameter(20, 'speeds sampled', number(1), live=True)
+    vy_samples: int = parameter(0, 'unused: all y speeds are 0 on a differential base', non_negative, live=True)
+    vth_samples: int = parameter(40, 'turn rates sampled', number(1), live=True)
+    controller_frequency: float = parameter(10.0, 'Hz: the window of reachable speeds is one period of the '
+                                                  'accelerations', positive, 'Hz')
+    path_distance_bias: float = parameter(32.0, 'weight of staying on the global plan', non_negative, live=True)
+    goal_distance_bias: float = parameter(20.0, 'weight of getting to the local goal', non_negative, live=True)
+    occdist_scale: float = parameter(0.02, 'weight of keeping off obstacles', non_negative, live=True)
+    obstacle_clearance: float = parameter(0.12, 'm (ours): trajectories keep this far from obstacles whenever one can',
+                                          non_negative, 'm')
+    forward_point_distance: float = parameter(0.325, 'm: the point ahead scored too', None, 'm', live=True)
+    forward_point_scoring: bool = parameter(True, "ours: false scores a trajectory's end alone (turns in place by "
+                                                  'the goal distance forward_point_distance ahead), as '
+                                                  "base_local_planner's TrajectoryPlannerROS does")
+    stop_time_buffer: float = parameter(0.2, 's: a trajectory must stop this long before an obstacle', non_negative,
+                                        's', live=True)
+    scaling_speed: float = parameter(0.25, 'm/s: above it the footprint is scaled up', non_negative, 'm/s', live=True)
+    max_scaling_factor: float = parameter(0.2, 'up to 1 + this', non_negative, live=True)
+    oscillation_reset_dist: float = parameter(0.05, 'm: moving this far resets the oscillation flags', non_negative,
+                                              'm', live=True)
+    oscillation_reset_angle: float = parameter(0.2, 'rad: turning this far resets them too', non_negative, 'rad',
+                                               live=True)
+    trans_stopped_vel: float = parameter(0.1, 'm/s: slower counts as stopped', non_negative, 'm/s', live=True)
+    theta_stopped_vel: float = parameter(0.1, 'rad/s: slower counts as stopped', non_negative, 'rad/s', live=True)
+
+    def check_together(self):
         if self.min_vel_x > self.max_vel_x:
-            raise ValueError('min_vel_x (%r) must not exceed max_vel_x (%r)' % (self.min_vel_x, self.max_vel_x))
-        for name in ('controller_frequency', 'sim_time', 'sim_granularity', 'angular_sim_granularity',
-                     'max_vel_trans', 'max_vel_theta'):
-            if not getattr(self, name) > 0:
-                raise ValueError('%s must be > 0, not %r' % (name, getattr(self, name)))
+            fail('min_vel_x', self.min_vel_x, 'must not exceed ~max_vel_x (%r)' % self.max_vel_x)
 
     @property
     def sim_period(self):
@@ -133,12 +135,14 @@ def dwa_config(model='burger', move_forward_only=False, **overrides):
 @dataclass(frozen=True)
 class Command:
     """A velocity command (v m/s, w rad/s), whether the controller found one (ok), the
-    trajectory it follows (n, 3) (the local plan) and, when not ok, why."""
+    trajectory it follows (n, 3) (the local plan), when not ok, why, and the part of the
+    global plan it followed (DWAPlannerROS's global_plan)."""
     v: float
     w: float
     ok: bool
     trajectory: np.ndarray = None
     reason: str = ''
+    followed: np.ndarray = None
 
 
 class DwaController(object):
@@ -146,10 +150,14 @@ class DwaController(object):
 
     def __init__(self, costmap, config=DwaConfig()):
         self.costmap = costmap
-        self.config = config
         self.scorer = TrajectoryScorer(costmap, config)
+        self.configure(config)
         self._rotating = False  # turning to the goal's yaw (LatchedStopRotateController's rotating_to_goal_)
         self.reset()
+
+    def configure(self, config):
+        """New parameters (dynamic_reconfigure's): the next compute() samples and scores with them."""
+        self.config = self.scorer.config = config
 
     def reset(self):
         """A new global plan: forget the goal latch and the oscillation flags (DWAPlannerROS::setPlan).
@@ -223,7 +231,7 @@ class DwaController(object):
         else:
             self._rotating = False
             command = self._dwa(pose, velocity, local, plan[-1])
-        return self._safe(command)
+        return replace(self._safe(command), followed=local)
 
     def _local_plan(self, pose, plan):
         """transformGlobalPlan: from the first pose within half the costmap's size of the
@@ -314,19 +322,19 @@ class DwaController(object):
     def _update_flags(self, pose, v, w):
         flags, config = self._flags, self.config
         set_now = False
-        for value, positive, negative, positive_only, negative_only, applies in (
+        for value, up, down, up_only, down_only, applies in (
                 (v, 'forward', 'backward', 'forward_only', 'backward_only', True),
                 (w, 'left', 'right', 'left_only', 'right_only', abs(v) <= config.min_vel_trans)):
             if not applies:
                 continue
             if value < 0:
-                if flags.get(positive):
-                    flags[negative_only] = set_now = True
-                flags[positive], flags[negative] = False, True
+                if flags.get(up):
+                    flags[down_only] = set_now = True
+                flags[up], flags[down] = False, True
             elif value > 0:
-                if flags.get(negative):
-                    flags[positive_only] = set_now = True
-                flags[negative], flags[positive] = False, True
+                if flags.get(down):
+                    flags[up_only] = set_now = True
+                flags[down], flags[up] = False, True
         if set_now:
             self._stationary = np.array(pose, dtype=float)
         if any(flags.get(name) for name in ('forward_only', 'backward_only', 'left_only', 'right_only')):

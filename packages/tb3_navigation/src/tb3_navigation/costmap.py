@@ -12,7 +12,8 @@ tb3_common.grid.Grid:
 - obstacles: a scan marks LETHAL the cell of each hit nearer than
   obstacle_range and clears the cells its beams cross up to raytrace_range
   (laser_geometry drops readings at or past range_max, so these beams clear
-  nothing unless inf_is_valid); the robot's footprint is cleared. Its cells
+  nothing unless inf_is_valid), each as its observation source says
+  (marking, clearing, its own ranges); the robot's footprint is cleared. Its cells
   default to FREE_SPACE unless track_unknown_space, and are laid on the master
   with "maximum" where they know something. So with TurtleBot3's values
   (track_unknown_space unset: false) the map's unknown cells end up FREE in
@@ -21,13 +22,17 @@ tb3_common.grid.Grid:
 - inflation: cost = 252 exp(-cost_scaling_factor (d - inscribed_radius)) at a
   distance d from the nearest lethal cell's centre up to inflation_radius,
   INSCRIBED_INFLATED_OBSTACLE within the inscribed radius; a cell keeps its
-  own cost if higher, an unknown cell stays unknown unless inscribed.
+  own cost if higher, an unknown cell stays unknown unless inscribed (or,
+  with inflate_unknown, unless the inflation gives it any cost). Its two
+  parameters and inflate_unknown may change on a running costmap
+  (reconfigure: dynamic_reconfigure's inflation_layer).
 
 The footprint is padded by footprint_padding (costmap_2d's default 0.01 m)
 and its radii come from it: the Burger's padded footprint is 0.166 x 0.23 m
 with base_footprint 0.051 m behind its front edge, so its inscribed radius
 is 0.051 m (a single cell's centre at 0.05 m is already outside it) and its
-circumscribed radius 0.163 m.
+circumscribed radius 0.163 m. A robot_radius instead of a footprint is
+costmap_2d's 16-corner polygon of it (circle_footprint).
 """
 import math
 from dataclasses import dataclass
@@ -36,6 +41,7 @@ import numpy as np
 from scipy.ndimage import distance_transform_edt
 
 from tb3_common.grid import Grid
+from tb3_common.params import Checked, non_negative, number, parameter, points
 from tb3_navigation.raytrace import crossed_cells
 from tb3_navigation.scan import endpoints
 
@@ -45,50 +51,43 @@ FREE_SPACE, INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE, NO_INFORMATION = 0, 25
 BURGER_FOOTPRINT = ((-0.105, -0.105), (-0.105, 0.105), (0.041, 0.105), (0.041, -0.105))
 WAFFLE_FOOTPRINT = ((-0.205, -0.155), (-0.205, 0.155), (0.077, 0.155), (0.077, -0.155))
 
-#: For the node around the core: turtlebot3_navigation/param/global_costmap_params.yaml and
-#: local_costmap_params.yaml (noetic), the costmaps' frames, rates and windows.
-GLOBAL_COSTMAP = dict(global_frame='map', robot_base_frame='base_footprint', update_frequency=10.0,
-                      publish_frequency=10.0, transform_tolerance=0.5, static_map=True)
-LOCAL_COSTMAP = dict(global_frame='odom', robot_base_frame='base_footprint', update_frequency=10.0,
-                     publish_frequency=10.0, transform_tolerance=0.5, static_map=False, rolling_window=True,
-                     width=3.0, height=3.0, resolution=0.05)
-
 #: costmap_2d's publisher: costs to OccupancyGrid values (0, 1..98, 99 inscribed, 100 lethal, -1 unknown).
 TRANSLATION = np.array([0] + [1 + (97 * (cost - 1)) // 251 for cost in range(1, 253)] + [99, 100, -1], dtype=np.int8)
 
 
 @dataclass(frozen=True)
-class CostmapConfig:
-    """costmap_2d's parameters, TurtleBot3's values (the Burger's footprint)."""
-    footprint: tuple = BURGER_FOOTPRINT  # m: the robot's outline in base_footprint (the Burger's)
-    footprint_padding: float = 0.01  # m added around the footprint
-    obstacle_range: float = 3.0  # m: scan hits nearer than this are marked
-    raytrace_range: float = 3.5  # m: space along a beam is cleared up to this
-    inflation_radius: float = 1.0  # m: costs fall off this far from an obstacle
-    cost_scaling_factor: float = 3.0  # how fast: 252 exp(-factor (d - inscribed radius))
-    track_unknown_space: bool = False  # true: unseen cells stay unknown (plans avoid them unless allow_unknown)
-    lethal_cost_threshold: int = 100  # map cells this or more are obstacles
-    inf_is_valid: bool = False  # true: beams reading inf clear up to raytrace_range
-    footprint_clearing_enabled: bool = True  # the robot's own footprint is cleared of obstacles
-
-    def __post_init__(self):
-        points = np.asarray(self.footprint, dtype=float)
-        if points.ndim != 2 or points.shape[1] != 2 or len(points) < 3 or not np.all(np.isfinite(points)):
-            raise ValueError('footprint must be a list of at least 3 finite [x, y] points, not %r'
-                             % (self.footprint,))
-        for name in ('footprint_padding', 'obstacle_range', 'raytrace_range', 'inflation_radius',
-                     'cost_scaling_factor'):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-                raise ValueError('%s must be a finite number >= 0, not %r' % (name, value))
-        if not 0 <= self.lethal_cost_threshold <= 100:
-            raise ValueError('lethal_cost_threshold must be within 0..100, not %r' % (self.lethal_cost_threshold,))
+class CostmapConfig(Checked):
+    """costmap_2d's parameters, TurtleBot3's values (the Burger's footprint); `live` ones are the
+    inflation layer's (InflationPlugin.cfg): dynamic_reconfigure changes them on a running node."""
+    footprint: tuple = parameter(BURGER_FOOTPRINT, "m: the robot's outline in base_footprint (the Burger's)",
+                                 points(3), 'm')
+    footprint_padding: float = parameter(0.01, 'm added around the footprint', non_negative, 'm')
+    obstacle_range: float = parameter(3.0, 'm: scan hits nearer than this are marked', non_negative, 'm')
+    raytrace_range: float = parameter(3.5, 'm: space along a beam is cleared up to this', non_negative, 'm')
+    inflation_radius: float = parameter(1.0, 'm: costs fall off this far from an obstacle', non_negative, 'm',
+                                        live=True)
+    cost_scaling_factor: float = parameter(3.0, 'how fast: 252 exp(-factor (d - inscribed radius))', non_negative,
+                                           live=True)
+    inflate_unknown: bool = parameter(False, 'true: unknown cells take any inflated cost (false: only inscribed)',
+                                      live=True)
+    track_unknown_space: bool = parameter(False, 'true: unseen cells stay unknown (plans avoid them unless '
+                                                 'allow_unknown)')
+    lethal_cost_threshold: int = parameter(100, 'map cells this or more are obstacles', number(0, 100))
+    inf_is_valid: bool = parameter(False, 'true: beams reading inf clear up to raytrace_range')
+    footprint_clearing_enabled: bool = parameter(True, "the robot's own footprint is cleared of obstacles")
 
     @property
     def padded_footprint(self):
         """The footprint (n, 2) pushed out by footprint_padding in x and y, as costmap_2d's padFootprint."""
         points = np.asarray(self.footprint, dtype=float)
         return points + np.sign(points) * self.footprint_padding
+
+
+def circle_footprint(radius):
+    """costmap_2d's makeFootprintFromRadius: the 16-corner polygon ((x, y), ...) it makes of
+    `robot_radius` when no footprint is given."""
+    angles = np.arange(16) * 2.0 * math.pi / 16
+    return tuple((float(math.cos(angle) * radius), float(math.sin(angle) * radius)) for angle in angles)
 
 
 def footprint_radii(footprint):
@@ -138,12 +137,9 @@ class Costmap(object):
     """
 
     def __init__(self, grid, config=CostmapConfig(), static=None, rolling=False):
-        self.config = config
         self.grid = grid
         self.rolling_window = rolling
-        self.footprint = config.padded_footprint
-        self.inscribed_radius, self.circumscribed_radius = footprint_radii(self.footprint)
-        self._outline = outline(self.footprint, grid.resolution / 2.0)
+        self._take(config)
         self._default = NO_INFORMATION if config.track_unknown_space else FREE_SPACE
         self.static = None
         if static is not None:
@@ -159,6 +155,17 @@ class Costmap(object):
         origin = (centre[0] - columns * resolution / 2.0, centre[1] - rows * resolution / 2.0, 0.0)
         return cls(Grid(resolution, columns, rows, origin), config, rolling=True)
 
+    def _take(self, config):
+        self.config = config
+        self.footprint = config.padded_footprint
+        self.inscribed_radius, self.circumscribed_radius = footprint_radii(self.footprint)
+        self._outline = outline(self.footprint, self.grid.resolution / 2.0)
+
+    def reconfigure(self, config):
+        """New parameters (dynamic_reconfigure's: the inflation's): the costs combined anew with them."""
+        self._take(config)
+        self.update_costs()
+
     def interpret_map(self, data):
         """Static layer costs of OccupancyGrid values (StaticLayer::interpretValue, trinary)."""
         raw = np.asarray(data).astype(np.int16) & 0xFF  # as costmap_2d reads them: unsigned char
@@ -167,29 +174,32 @@ class Costmap(object):
 
     # --- updates ------------------------------------------------------------------------------
 
-    def update(self, robot_pose, scan=None, sensor_pose=None):
+    def update(self, robot_pose, scan=None, sensor_pose=None, source=None):
         """One update cycle: follow the robot (rolling), clear and mark from `scan`
         seen from `sensor_pose` (x, y, yaw in this costmap's frame), clear the
-        footprint at `robot_pose`, then combine the layers."""
+        footprint at `robot_pose`, then combine the layers. `source` (costmap_2d's
+        observation source: marking, clearing, obstacle_range, raytrace_range and
+        inf_is_valid attributes) says how the scan is used; None: the config's way."""
         if self.rolling_window:
             self._follow(robot_pose)
         if scan is not None:
-            self._observe(scan, sensor_pose)
+            self._observe(scan, sensor_pose, source or _Source(self.config))
         if self.config.footprint_clearing_enabled:
             cells = self.footprint_cells(robot_pose)
             self.obstacles.ravel()[cells] = FREE_SPACE
         self.update_costs()
 
-    def _observe(self, scan, sensor_pose):
+    def _observe(self, scan, sensor_pose, source):
         """Clear along each usable beam up to raytrace_range, then mark hits within obstacle_range."""
-        config = self.config
         ranges = np.nan_to_num(scan.ranges, nan=np.inf)
-        use = scan.hits | (scan.misses if config.inf_is_valid else False)
-        length = np.minimum(np.where(scan.hits, ranges, config.raytrace_range), config.raytrace_range)
+        use = scan.hits | (scan.misses if source.inf_is_valid else False)
+        length = np.minimum(np.where(scan.hits, ranges, source.raytrace_range), source.raytrace_range)
         ends = self._clipped(sensor_pose[:2], endpoints(sensor_pose, scan.angles[use], length[use]))
-        if ends is not None:
+        if ends is not None and source.clearing:
             self.obstacles.ravel()[crossed_cells(self.grid, sensor_pose[:2], ends)] = FREE_SPACE
-        marked = scan.hits & (ranges < config.obstacle_range)
+        if not source.marking:
+            return
+        marked = scan.hits & (ranges < source.obstacle_range)
         cells = self.grid.to_cells(endpoints(sensor_pose, scan.angles[marked], ranges[marked]))
         cells = cells[self.grid.inside(cells)]
         self.obstacles[cells[:, 1], cells[:, 0]] = LETHAL_OBSTACLE
@@ -243,7 +253,8 @@ class Costmap(object):
             return master
         inflated = inflation_costs(distance_transform_edt(~lethal), self.grid.resolution, self.inscribed_radius,
                                    config.inflation_radius, config.cost_scaling_factor)
-        unknown_value = np.where(inflated >= INSCRIBED_INFLATED_OBSTACLE, inflated, NO_INFORMATION)
+        taken = inflated > FREE_SPACE if config.inflate_unknown else inflated >= INSCRIBED_INFLATED_OBSTACLE
+        unknown_value = np.where(taken, inflated, NO_INFORMATION)
         return np.where(master == NO_INFORMATION, unknown_value, np.maximum(master, inflated))
 
     def clear_obstacles(self, centre, size, inside=False):
@@ -310,6 +321,15 @@ class Costmap(object):
     def occupancy_grid(self):
         """The costs as nav_msgs/OccupancyGrid values (int8 [iy, ix]), as costmap_2d publishes them."""
         return occupancy_values(self.costs)
+
+
+class _Source(object):
+    """A scan used as the config says: marked and cleared, with its ranges."""
+
+    def __init__(self, config):
+        self.marking = self.clearing = True
+        self.obstacle_range, self.raytrace_range = config.obstacle_range, config.raytrace_range
+        self.inf_is_valid = config.inf_is_valid
 
 
 def _inside_convex(polygon, points):

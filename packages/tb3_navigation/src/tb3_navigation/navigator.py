@@ -35,6 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tb3_common.params import Checked, frame_id, non_negative, number, parameter, positive
 from tb3_common.pose2d import IDENTITY, compose, yaw_of_quaternion
 from tb3_navigation.recovery import RotateRecovery, RotateRecoveryConfig
 
@@ -51,47 +52,41 @@ TRIGGER_TEXT = {PLANNING_R: 'no valid plan within planner_patience',
                 OSCILLATION_R: 'not moving oscillation_distance within oscillation_timeout'}
 STOP = (0.0, 0.0)
 DEFAULT_RECOVERIES = ('conservative_reset', 'rotate_recovery', 'aggressive_reset', 'rotate_recovery')
+RECOVERIES = ('conservative_reset', 'aggressive_reset', 'rotate_recovery')
+
+
+def _behaviours(value):
+    unknown = [name for name in value if name not in RECOVERIES]
+    return 'unknown behaviour %r (%s)' % (unknown[0], ', '.join(RECOVERIES)) if unknown else None
 
 
 @dataclass(frozen=True)
-class NavigatorConfig:
+class NavigatorConfig(Checked):
     """move_base's parameters: TurtleBot3's move_base_params.yaml, move_base's defaults for the rest.
     recovery_behaviors names the behaviours in order (move_base's list gives {name, type}
     each: the node passes the names of the clear_costmap_recovery and rotate_recovery ones)."""
-    global_frame: str = 'map'  # the global costmap's frame: goals are planned in it
-    controller_frequency: float = 10.0  # Hz: control cycles (sim time)
-    planner_frequency: float = 5.0  # Hz: the global plan is made anew this often while driving; 0: only once per goal
-    planner_patience: float = 5.0  # s without a plan before the recoveries
-    controller_patience: float = 15.0  # s without a valid command before the recoveries
-    max_planning_retries: int = -1  # failed plans before the recoveries; -1: planner_patience alone decides
-    oscillation_timeout: float = 10.0  # s without moving oscillation_distance before the recoveries; 0: never
-    oscillation_distance: float = 0.2  # m: moving this far resets the oscillation timer
-    conservative_reset_dist: float = 3.0  # m: the first recovery forgets obstacles outside this square
-    circumscribed_radius: float = 0.46  # m: the aggressive reset's square is 4 times this
-    recovery_behavior_enabled: bool = True  # false: no recoveries, ABORTED at once
-    clearing_rotation_allowed: bool = True  # false: the recoveries do not turn in place
-    recovery_behaviors: tuple = DEFAULT_RECOVERIES  # move_base's default four, in its order
-    quaternion_norm_tolerance: float = 1e-3  # a goal's quaternion further than this from length 1 is ABORTED
-    rotation_timeout: float = 30.0  # s: a recovery turn gives up after this (ours: a robot that cannot turn)
-    rotate_recovery: RotateRecoveryConfig = RotateRecoveryConfig()  # frozen: one shared default is safe
-
-    def __post_init__(self):
-        for name in ('controller_frequency', 'planner_frequency', 'planner_patience', 'controller_patience',
-                     'oscillation_timeout', 'oscillation_distance', 'conservative_reset_dist',
-                     'circumscribed_radius', 'quaternion_norm_tolerance', 'rotation_timeout'):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-                    or value < 0:
-                raise ValueError('%s must be a finite number >= 0, not %r' % (name, value))
-        if not isinstance(self.global_frame, str) or not self.global_frame.strip('/'):
-            raise ValueError('global_frame must be a frame name, not %r' % (self.global_frame,))
-        if not self.controller_frequency > 0:
-            raise ValueError('controller_frequency must be > 0, not %r' % (self.controller_frequency,))
-        unknown = [name for name in self.recovery_behaviors if name not in
-                   ('conservative_reset', 'aggressive_reset', 'rotate_recovery')]
-        if unknown:
-            raise ValueError('recovery_behaviors: unknown behaviour %r (conservative_reset, aggressive_reset, '
-                             'rotate_recovery)' % (unknown[0],))
+    global_frame: str = parameter('map', 'the global costmap\'s frame: goals are planned in it', frame_id)
+    controller_frequency: float = parameter(10.0, 'Hz: control cycles (sim time)', positive, 'Hz')
+    planner_frequency: float = parameter(5.0, 'Hz: the global plan is made anew this often while driving; 0: only '
+                                              'once per goal', non_negative, 'Hz')
+    planner_patience: float = parameter(5.0, 's without a plan before the recoveries', non_negative, 's')
+    controller_patience: float = parameter(15.0, 's without a valid command before the recoveries', non_negative, 's')
+    max_planning_retries: int = parameter(-1, 'failed plans before the recoveries; -1: planner_patience alone '
+                                              'decides', number(-1))
+    oscillation_timeout: float = parameter(10.0, 's without moving oscillation_distance before the recoveries; 0: '
+                                                 'never', non_negative, 's')
+    oscillation_distance: float = parameter(0.2, 'm: moving this far resets the oscillation timer', non_negative, 'm')
+    conservative_reset_dist: float = parameter(3.0, 'm: the first recovery forgets obstacles outside this square',
+                                               non_negative, 'm')
+    circumscribed_radius: float = parameter(0.46, "m: the aggressive reset's square is 4 times this (move_base "
+                                                  'reads it as ~local_costmap/circumscribed_radius)', non_negative, 'm')
+    recovery_behavior_enabled: bool = parameter(True, 'false: no recoveries, ABORTED at once')
+    clearing_rotation_allowed: bool = parameter(True, 'false: the recoveries do not turn in place')
+    recovery_behaviors: tuple = parameter(DEFAULT_RECOVERIES, "move_base's default four, in its order", _behaviours)
+    quaternion_norm_tolerance: float = parameter(1e-3, "a goal's quaternion further than this from length 1 is "
+                                                       'ABORTED', non_negative)
+    rotation_timeout: float = parameter(30.0, 's: a recovery turn gives up after this (ours: a robot that cannot '
+                                              'turn)', non_negative, 's')
 
 
 @dataclass(frozen=True)
@@ -106,13 +101,15 @@ class Outcome:
 class Step:
     """What one cycle wants: cmd (v, w) to send, or None (send nothing); the state; the
     goal's Outcome if it ended; the global plan if a new one was made; the local plan;
-    the recovery behaviour started, if any."""
+    the recovery behaviour started, if any; the part of the global plan the controller
+    followed (in the local frame)."""
     cmd: tuple
     state: str
     outcome: Outcome = None
     plan: list = None
     local_plan: np.ndarray = None
     recovery: str = None
+    followed: np.ndarray = None
 
 
 def goal_error(position, orientation, tolerance=1e-3):
@@ -140,10 +137,11 @@ class Navigator(object):
     `controller` has reset(), is_goal_reached(pose, velocity, plan) and compute(pose,
     velocity, plan) -> a Command (v, w, ok, trajectory), in the local costmap's frame;
     the costmaps (or None) have clear_obstacles(centre, size), reset(), and the local
-    one footprint_cost(poses)."""
+    one footprint_cost(poses); `rotation` configures rotate_recovery."""
 
-    def __init__(self, config, planner, controller, global_costmap=None, local_costmap=None):
-        self.config, self.planner, self.controller = config, planner, controller
+    def __init__(self, config, planner, controller, global_costmap=None, local_costmap=None,
+                 rotation=RotateRecoveryConfig()):
+        self.config, self.planner, self.controller, self.rotation = config, planner, controller, rotation
         self.global_costmap, self.local_costmap = global_costmap, local_costmap
         self.goal = None
         self.plan = None
@@ -201,17 +199,18 @@ class Navigator(object):
 
     # --- services ---------------------------------------------------------------------------
 
-    def make_plan(self, start, goal, tolerance=0.0):
+    def make_plan(self, start, goal, tolerance=0.0, add_unreachable_goal=True):
         """The make_plan service: a plan from `start` to `goal` (x, y, yaw) on the global
         costmap, else one to the reachable point nearest the goal within `tolerance`
-        with the goal appended (make_plan_add_unreachable_goal); [] if none; None while
-        a goal is active (move_base refuses then)."""
+        with the goal appended if `add_unreachable_goal` (move_base's
+        make_plan_add_unreachable_goal); [] if none; None while a goal is active (move_base
+        refuses then)."""
         if self.active:
             return None
         plan = self.planner.make_plan(self.global_costmap, start, goal)
         if not plan and tolerance > 0:
             plan = self.planner.make_plan(self.global_costmap, start, goal, tolerance)
-            plan = plan + [tuple(float(v) for v in goal)] if plan else plan
+            plan = plan + [tuple(float(v) for v in goal)] if plan and add_unreachable_goal else plan
         return plan or []
 
     def clear_costmaps(self):
@@ -286,7 +285,7 @@ class Navigator(object):
             if self._trigger == CONTROLLING_R:
                 self._recovery_index = 0
             return Step((float(command.v), float(command.w)), CONTROLLING, plan=new_plan,
-                        local_plan=command.trajectory)
+                        local_plan=command.trajectory, followed=getattr(command, 'followed', None))
         if now > self._last_valid_control + config.controller_patience:
             self.state, self._trigger = CLEARING, CONTROLLING_R
         else:
@@ -317,8 +316,7 @@ class Navigator(object):
             started = behaviours[self._recovery_index]
             self._recovery_index += 1
             if started == 'rotate_recovery':
-                self._behaviour = RotateRecovery(self.config.rotate_recovery, now, local[2],
-                                                 self.config.rotation_timeout)
+                self._behaviour = RotateRecovery(self.rotation, now, local[2], self.config.rotation_timeout)
             else:
                 size = (self.config.conservative_reset_dist if started == 'conservative_reset'
                         else 4.0 * self.config.circumscribed_radius)

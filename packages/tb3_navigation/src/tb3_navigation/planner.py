@@ -12,7 +12,13 @@ over the 8 neighbours of each cell (no diagonal step between two blocked
 cells), found by scipy's Dijkstra at C speed (tb3_navigation.grid_graph),
 and the walk follows its predecessors, so each step of the plan goes to
 the neighbour the cheapest path came from. Orientations are those of global_planner's orientation
-filter (forward): each pose faces the next, the last one is the goal's.
+filter (forward by default): each pose faces the next, the last one is the goal's.
+
+global_planner/GlobalPlanner is the same search with its own step cost
+(getCost: lethal_cost blocks, steps capped one below it; its defaults
+neutral 50, factor 3.0, lethal 253) and its orientation modes. Its other
+ways of finding a plan (use_dijkstra false: A*, use_quadratic,
+use_grid_path false: gradient descent) end on the same cheapest path here.
 
 make_plan's tolerance is navfn's: when it is > 0, the plan goes to the
 reachable point nearest to the goal within the square goal +- tolerance,
@@ -20,9 +26,12 @@ sampled at the costmap's resolution.
 """
 import math
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 
+from tb3_common.params import Checked, fail, non_negative, number, parameter
+from tb3_common.pose2d import normalize_angle
 from tb3_navigation.costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION
 from tb3_navigation.grid_graph import UNREACHED, build, path_to, shortest_paths
 
@@ -30,21 +39,28 @@ COST_OBS = 254  # navfn: the step cost of a cell it must not enter (and one belo
 
 
 @dataclass(frozen=True)
-class PlannerConfig:
-    """navfn's parameters (neutral_cost and cost_factor are global_planner's names for
-    navfn's fixed COST_NEUTRAL 50 and COST_FACTOR 0.8)."""
-    allow_unknown: bool = True  # plans may cross unknown cells
-    default_tolerance: float = 0.0  # m: how far from an unreachable goal a plan may end
-    neutral_cost: float = 50.0  # a free cell's step cost (navfn's COST_NEUTRAL)
-    cost_factor: float = 0.8  # each unit of a cell's cost adds this to its step cost (navfn's COST_FACTOR)
+class PlannerConfig(Checked):
+    """navfn's parameters, and global_planner's where it has more (neutral_cost and cost_factor are
+    global_planner's names for navfn's fixed COST_NEUTRAL 50 and COST_FACTOR 0.8)."""
+    allow_unknown: bool = parameter(True, 'plans may cross unknown cells')
+    default_tolerance: float = parameter(0.0, 'm: how far from an unreachable goal a plan may end', non_negative, 'm')
+    neutral_cost: float = parameter(50.0, "a free cell's step cost (navfn's COST_NEUTRAL)", number(1.0, 255.0))
+    cost_factor: float = parameter(0.8, "each unit of a cell's cost adds this to its step cost (navfn's COST_FACTOR)",
+                                   non_negative)
+    lethal_cost: Optional[int] = parameter(None, "global_planner's: cells this dear are blocked, steps cost at most "
+                                                 "one less; unset: navfn's rule (253 blocked, steps up to 253)",
+                                           number(1, 255))
+    orientation_mode: int = parameter(1, "global_planner's: the plan's headings: 0 none, 1 forward, 2 interpolate, "
+                                         '3 forward then interpolate, 4 backward, 5 leftward, 6 rightward',
+                                  number(0, 6))
+    orientation_window_size: Optional[int] = parameter(None, "global_planner's: a pose heads from this many poses "
+                                                             'before it to as many after it; unset: to the next one',
+                                                       number(1))
 
-    def __post_init__(self):
-        for name in ('default_tolerance', 'cost_factor'):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-                raise ValueError('%s must be a finite number >= 0, not %r' % (name, value))
-        if not (isinstance(self.neutral_cost, (int, float)) and 1 <= self.neutral_cost < COST_OBS):
-            raise ValueError('neutral_cost must be within 1..253, not %r' % (self.neutral_cost,))
+    def check_together(self):
+        highest = COST_OBS - 1 if self.lethal_cost is None else self.lethal_cost - 1
+        if self.neutral_cost > highest:
+            fail('neutral_cost', self.neutral_cost, 'must be <= %d (a step costs at most that)' % highest)
 
 
 class GlobalPlanner(object):
@@ -57,13 +73,21 @@ class GlobalPlanner(object):
         self._graphs = {}  # of the costs: None: plain; a goal's cell: reweighted toward it (A*)
 
     def step_costs(self, costs):
-        """navfn's setCostmap: the cost (float (H, W)) of stepping into each cell, inf if it is blocked."""
+        """navfn's setCostmap (global_planner's getCost with a lethal_cost): the cost (float (H, W)) of
+        stepping into each cell, inf if it is blocked."""
         config = self.config
         costs = np.asarray(costs)
-        steps = np.minimum(config.neutral_cost + config.cost_factor * costs.astype(float), COST_OBS - 1)
-        blocked = costs >= INSCRIBED_INFLATED_OBSTACLE
+        steps = config.neutral_cost + config.cost_factor * costs.astype(float)
+        if config.lethal_cost is None:
+            steps, unknown = np.minimum(steps, COST_OBS - 1), COST_OBS - 1
+            blocked = costs >= INSCRIBED_INFLATED_OBSTACLE
+        else:
+            lethal = config.lethal_cost
+            steps = np.where(costs < lethal - 1, np.minimum(steps, lethal - 1), lethal)
+            blocked = costs >= lethal
+            unknown = min(config.neutral_cost + config.cost_factor * NO_INFORMATION, lethal - 1)
         if config.allow_unknown:
-            steps = np.where(costs == NO_INFORMATION, COST_OBS - 1, steps)
+            steps = np.where(costs == NO_INFORMATION, unknown, steps)
             blocked &= costs != NO_INFORMATION
         return np.where(blocked, np.inf, steps)
 
@@ -88,7 +112,9 @@ class GlobalPlanner(object):
         end, index = target
         cells = np.array(path_to(predecessors, index)[1:-1], dtype=int)
         middle = grid.centres(np.stack((cells % grid.width, cells // grid.width), axis=-1)).reshape(-1, 2)
-        return orient([tuple(start[:2])] + [tuple(point) for point in middle] + [end], goal[2])
+        start_yaw = float(start[2]) if len(start) > 2 else 0.0
+        return orient([tuple(start[:2])] + [tuple(point) for point in middle] + [end], goal[2],
+                      self.config.orientation_mode, self.config.orientation_window_size, start_yaw)
 
     def spread(self, costmap, start):
         """navfn's computePotential from the robot at `start` (x, y) over the whole costmap:
@@ -170,13 +196,36 @@ class GlobalPlanner(object):
         return tuple(points[best]), int(cells[best, 1] * grid.width + cells[best, 0])
 
 
-def orient(points, goal_yaw):
-    """Poses [(x, y, yaw)] of points [(x, y)]: each faces the next, the last has `goal_yaw`."""
+#: global_planner's orientation modes beyond forward: the turn from the heading along the plan.
+TURNED = {4: math.pi, 5: -math.pi / 2, 6: math.pi / 2}
+
+
+def orient(points, goal_yaw, mode=1, window=None, start_yaw=0.0):
+    """Poses [(x, y, yaw)] of points [(x, y)] as global_planner's OrientationFilter heads them (`mode`
+    its orientation_mode, `window` its orientation_window_size): forward, each faces along the plan
+    (from `window` points before it to as many after; None: to the next), the last has `goal_yaw`. Interpolation runs
+    from `start_yaw` (the robot's) to the goal's, or, in mode 3, from the last turn over 0.35 rad
+    onwards: back from the third last pose while the headings stay within 0.35 rad of its
+    (global_planner adds the start index to every interpolated yaw once too often; not here)."""
     points = np.asarray(points, dtype=float)
-    yaws = np.full(len(points), float(goal_yaw))
-    if len(points) > 1:
-        steps = np.diff(points, axis=0)
-        yaws[:-1] = np.arctan2(steps[:, 1], steps[:, 0])
+    count = len(points)
+    yaws = np.zeros(count) if mode == 0 else np.full(count, float(goal_yaw))
+    if count > 1 and mode != 0:
+        index = np.arange(count - 1)
+        before = index if window is None else np.maximum(0, index - window)
+        after = index + 1 if window is None else np.minimum(count - 1, index + window)
+        yaws[:-1] = np.arctan2(points[after, 1] - points[before, 1], points[after, 0] - points[before, 0])
+        yaws[:-1] = normalize_angle(yaws[:-1] + TURNED.get(mode, 0.0))
+        first = 0
+        if mode == 3:
+            first = last = max(count - 3, 0)
+            while first > 0 and abs(normalize_angle(yaws[first - 1] - yaws[last])) <= 0.35:
+                first -= 1
+        if mode in (2, 3):
+            yaws[0] = start_yaw
+            span = normalize_angle(goal_yaw - yaws[first]) / max(count - 1 - first, 1)
+            yaws[first:] = normalize_angle(yaws[first] + span * np.arange(count - first))
+    yaws[-1] = goal_yaw
     return [(float(x), float(y), float(yaw)) for (x, y), yaw in zip(points, yaws)]
 
 

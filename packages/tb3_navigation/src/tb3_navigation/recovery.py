@@ -14,26 +14,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tb3_common.params import Checked, parameter, positive
 from tb3_common.pose2d import normalize_angle
 
 
 @dataclass(frozen=True)
-class RotateRecoveryConfig:
-    """rotate_recovery's parameters. It reads them under TrajectoryPlannerROS, which
-    TurtleBot3's move_base.launch does not load, so its defaults hold."""
-    sim_granularity: float = 0.017
-    acc_lim_theta: float = 3.2
-    max_vel_theta: float = 1.0
-    min_in_place_vel_theta: float = 0.4
-    yaw_goal_tolerance: float = 0.10
-
-    def __post_init__(self):
-        for name in ('sim_granularity', 'acc_lim_theta', 'max_vel_theta', 'min_in_place_vel_theta',
-                     'yaw_goal_tolerance'):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not (math.isfinite(value)
-                                                                                     and value > 0):
-                raise ValueError('rotate_recovery: %s must be a finite number > 0, not %r' % (name, value))
+class RotateRecoveryConfig(Checked):
+    """rotate_recovery's parameters: sim_granularity under its own name (~rotate_recovery/), the rest
+    under ~TrajectoryPlannerROS/, which TurtleBot3's move_base.launch does not load, so its defaults hold."""
+    sim_granularity: float = parameter(0.017, 'rad between footprint checks along the turn left', positive, 'rad')
+    acc_lim_theta: float = parameter(3.2, 'rad/s^2: the turn slows to stop in time', positive, 'rad/s^2')
+    max_vel_theta: float = parameter(1.0, 'rad/s: the fastest turn', positive, 'rad/s')
+    min_in_place_vel_theta: float = parameter(0.4, 'rad/s: the slowest turn', positive, 'rad/s')
+    yaw_goal_tolerance: float = parameter(0.10, 'rad: the turn is over this near the start yaw', positive, 'rad')
 
 
 class RotateRecovery(object):
