@@ -25,13 +25,16 @@
       ~odom_frame, ~base_frame        default /odom and /base_footprint
 """
 
+from math import degrees, radians
+
 import rospy
-from geometry_msgs.msg import Twist, Quaternion
-from dynamic_reconfigure.server import Server
 import tf
+from dynamic_reconfigure.server import Server
+from geometry_msgs.msg import Quaternion, Twist
+
 from tb3_sim_nav.cfg import CalibrateAngularConfig
-from transform_utils import quat_to_angle, normalize_angle
-from math import radians, degrees
+from transform_utils import normalize_angle, quat_to_angle
+
 
 class CalibrateAngular():
     def __init__(self):

@@ -25,12 +25,15 @@
       ~odom_frame, ~base_frame       default /odom and /base_footprint
 """
 
-import rospy
-from geometry_msgs.msg import Twist
-from dynamic_reconfigure.server import Server
-import tf
-from tb3_sim_nav.cfg import CalibrateLinearConfig
 from math import copysign, sqrt
+
+import rospy
+import tf
+from dynamic_reconfigure.server import Server
+from geometry_msgs.msg import Twist
+
+from tb3_sim_nav.cfg import CalibrateLinearConfig
+
 
 class CalibrateLinear():
     def __init__(self):

@@ -25,6 +25,7 @@ import rospy
 from gazebo_msgs.msg import ModelState, ModelStates
 from gazebo_msgs.srv import DeleteModel, SetModelState, SpawnModel
 from geometry_msgs.msg import Pose
+
 from tb3_common.ros.poses import plane_pose
 
 GOAL = 'goal'

@@ -13,11 +13,14 @@
       ~rate               control loop rate (Hz), default 20
 """
 
+from math import pi, radians, sqrt
+
 import rospy
-from geometry_msgs.msg import Twist, Point, Quaternion
 import tf
-from transform_utils import quat_to_angle, normalize_angle
-from math import radians, sqrt, pi
+from geometry_msgs.msg import Point, Quaternion, Twist
+
+from transform_utils import normalize_angle, quat_to_angle
+
 
 class NavSquare():
     def __init__(self):

@@ -17,9 +17,21 @@ import os
 import sys
 
 import bench_camera
-from bench_sim import (CPU_SCRIPT, ROOT, RTF_ROWS, measure_cpu_and_startup, measure_cpu_of_script, measure_floor,
-                       measure_rtf, median, run_scripts, verdict)
-from tb3_harness import leftovers, mapping, navigating, report, tutorial
+from bench_sim import (
+    CPU_SCRIPT,
+    ROOT,
+    RTF_ROWS,
+    measure_cpu_and_startup,
+    measure_cpu_of_script,
+    measure_floor,
+    measure_rtf,
+    median,
+    run_scripts,
+    verdict,
+)
+
+from tb3_common.pose2d import normalize_angle
+from tb3_harness import leftovers, mapping, navigating, tutorial
 from tb3_harness.measure import machine
 from tb3_harness.processes import RunError, say, start_master
 
@@ -126,7 +138,8 @@ def main(argv=None):
                     '  >= %g: %s' % (target, verdict(value >= target)) if target else ''))
         if cpu:
             lines += ['%-58s %11.1f%%  < %g %%: %s' % ('CPU of the simulator at factor 1, driving, all topics read',
-                                                       median(cpu), TARGETS['cpu'], verdict(median(cpu) < TARGETS['cpu'])),
+                                                       median(cpu), TARGETS['cpu'],
+                                                       verdict(median(cpu) < TARGETS['cpu'])),
                       '%-58s %11.1f%%  < %g %%: %s' % ('  the same, %s driving, no sensor read' % CPU_SCRIPT[:-3],
                                                        median(cpu_script), TARGETS['cpu'],
                                                        verdict(median(cpu_script) < TARGETS['cpu'])),
@@ -134,7 +147,8 @@ def main(argv=None):
                                                       median(startup), TARGETS['startup'],
                                                       verdict(median(startup) < TARGETS['startup']))]
         if floor:
-            lines += ['%-58s %11.1f%%' % ('  floor: a python loop paced to 100 Hz publishing /clock', median(floor[False])),
+            lines += ['%-58s %11.1f%%' % ('  floor: a python loop paced to 100 Hz publishing /clock',
+                                          median(floor[False])),
                       '%-58s %11.1f%%' % ('  floor: the same, a pybullet step each tick', median(floor[True]))]
         if camera:
             lines += bench_camera.table(*camera)
@@ -144,7 +158,7 @@ def main(argv=None):
             (wall_1, end_1), (wall_0, end_0) = scripts[1.0][script], scripts[0.0][script]
             ratio = wall_1 / wall_0
             apart = math.hypot(end_0[1] - end_1[1], end_0[2] - end_1[2])
-            turn = abs(math.degrees(report.normalize(end_0[3] - end_1[3])))
+            turn = abs(math.degrees(normalize_angle(end_0[3] - end_1[3])))
             lines += ['%-58s %7.1f s / %.1f s = %.1fx  >= %gx: %s'
                       % (script + ' wall time, factor 1 / factor 0', wall_1, wall_0, ratio,
                          TARGETS['speedup'], verdict(ratio >= TARGETS['speedup'])),

@@ -16,17 +16,26 @@ import argparse
 import datetime
 import os
 import platform
-import sys
 import time
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-from tb3_harness.drives import (TIGHT, WORLD_GOALS, WORLD_GOALS_ROUTE, WORLD_LOOP, WORLD_LOOP_START, record_drive,
-                                run, scan, travelled, world_grid)
+from tb3_common.map_files import load_map
+from tb3_harness import ROOT
+from tb3_harness.drives import (
+    TIGHT,
+    WORLD_GOALS,
+    WORLD_GOALS_ROUTE,
+    WORLD_LOOP,
+    WORLD_LOOP_START,
+    record_drive,
+    run,
+    scan,
+    travelled,
+    world_grid,
+)
 from tb3_navigation.amcl_config import AmclConfig
 from tb3_navigation.localization import RVIZ_COVARIANCE, Amcl
-from tb3_common.map_files import load_map
 
 AT_GOAL = 0.05  # m: a scan taken this near a goal counts as one at the goal
 

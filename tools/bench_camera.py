@@ -6,6 +6,7 @@ import os
 import time
 
 from bench_sim import LAUNCH, ROOT, WALLED_WORLD, median, verdict
+
 from tb3_harness.measure import cpu_seconds, sim_pid, sim_uri
 from tb3_harness.processes import Process, say, wait_until
 from tb3_harness.screen import start_xvfb
@@ -56,7 +57,8 @@ def measure_frames(runs):
                     walls.append(1000.0 * (time.perf_counter() - wall))
                     cpus.append(1000.0 * (time.process_time() - cpu))
                 costs[(name, width, height)] = (median(walls), median(cpus))
-                say('frame %d x %d, %s: %.1f ms wall, %.1f ms CPU' % ((width, height, name) + costs[(name, width, height)]))
+                say('frame %d x %d, %s: %.1f ms wall, %.1f ms CPU'
+                    % ((width, height, name) + costs[(name, width, height)]))
         finally:
             simulation.close()
     return costs, egl
@@ -88,14 +90,16 @@ def measure_camera(log_dir, model, size, rate, topics, seconds):
         wait_until(lambda: clock.clock is not None and clock.clock > 2.0, 120, '/clock')
         if topics is None:
             xvfb, display = start_xvfb()
-            viewers = [xvfb, Process('rviz', ['rosrun', 'rviz', 'rviz', '-d', os.path.join(ROOT, 'rviz', 'camera.rviz')],
-                                     log_dir, env=dict(os.environ, DISPLAY=display))]
+            view = os.path.join(ROOT, 'rviz', 'camera.rviz')
+            viewers = [xvfb, Process('rviz', ['rosrun', 'rviz', 'rviz', '-d', view], log_dir,
+                                     env=dict(os.environ, DISPLAY=display))]
             time.sleep(RVIZ_SETTLE)
         pid = sim_pid()
         sim_start, wall_start, cpu_start, frames_start = clock.clock, time.monotonic(), cpu_seconds(pid), len(frames)
         time.sleep(seconds)
         sim_end, wall_end, cpu_end, frames_end = clock.clock, time.monotonic(), cpu_seconds(pid), len(frames)
-        return ((sim_end - sim_start) / (wall_end - wall_start), 100.0 * (cpu_end - cpu_start) / (wall_end - wall_start),
+        wall = wall_end - wall_start
+        return ((sim_end - sim_start) / wall, 100.0 * (cpu_end - cpu_start) / wall,
                 (frames_end - frames_start) / (sim_end - sim_start))
     finally:
         for process in reversed(viewers):

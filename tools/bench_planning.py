@@ -10,22 +10,19 @@ turtlebot3_world's, and prints them with the machine and the date.
 import argparse
 import datetime
 import math
-import os
 import statistics
 import sys
 import time
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-from tb3_harness.nav_sim import SCAN_POSE, Lidar, costmaps, world_cut  # the tests' world, lidar and map
+from tb3_common.grid import Grid
+from tb3_common.pose2d import compose
 from tb3_harness.measure import machine
+from tb3_harness.nav_sim import SCAN_POSE, Lidar, costmaps, world_cut  # the tests' world, lidar and map
 from tb3_navigation.controller import DwaController, dwa_config
 from tb3_navigation.costmap import Costmap, CostmapConfig
-from tb3_common.grid import Grid
 from tb3_navigation.planner import GlobalPlanner, plan_length
-from tb3_common.pose2d import compose
 from tb3_sim_nav import world_map
 
 

@@ -1,4 +1,5 @@
-"""The lidars' cost with many Burgers in one world, core only, no ROS: bench_sim.py's ten in turtlebot3_world or thirty in turtlebot3_house.
+"""The lidars' cost with many Burgers in one world, core only, no ROS: bench_sim.py's ten in turtlebot3_world or
+thirty in turtlebot3_house.
 
 Times Lidar.read_all of all their lidars (CPU, time.process_time) and keeps
 their noiseless ranges. With --before, a second source tree (its src folder,

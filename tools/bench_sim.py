@@ -93,6 +93,7 @@ def house_spots(count, clearance=0.5, spacing=1.0):
     """`count` (x, y) spots of turtlebot3_house's floor, on a grid, at least
     `clearance` m from any wall and `spacing` m from multi_tb3.launch's three."""
     import numpy as np
+
     from tb3_sim_nav.world_file import load_world
     from tb3_sim_nav.world_map import in_plane, signed_distance
     walls = in_plane(load_world('turtlebot3_house', os.path.join(ROOT, 'worlds')).obstacles, 0.1)

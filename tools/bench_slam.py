@@ -11,7 +11,6 @@ odometry's, and the map's measures (tb3_harness.map_quality).
 """
 import argparse
 import datetime
-import math
 import os
 import platform
 import sys
@@ -19,12 +18,10 @@ import time
 
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-from tb3_harness.drives import (HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, path_length,
-                    record_drive)
-from tb3_harness.map_quality import measure as map_quality
 from tb3_common.pose2d import normalize_angle
+from tb3_harness import ROOT
+from tb3_harness.drives import HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, path_length, record_drive
+from tb3_harness.map_quality import measure as map_quality
 from tb3_navigation.scan import Scan
 from tb3_navigation.slam import Slam
 from tb3_sim_nav.world_file import load_world

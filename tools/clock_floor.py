@@ -7,20 +7,18 @@ its CPU as it does the simulator's, for scale.
 """
 import argparse
 import os
-import sys
 
 import rospy
 from rosgraph_msgs.msg import Clock
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, '..', 'src'))
+from tb3_sim_nav.frames import IDENTITY
+from tb3_sim_nav.pacing import Pacer
+from tb3_sim_nav.ros.publishers import Publishers
+from tb3_sim_nav.ros.rospy_internals import stop_following_clock
+from tb3_sim_nav.throttle import Throttle
+from tb3_sim_nav.world import World
 
-from tb3_sim_nav.frames import IDENTITY  # noqa: E402 (after the path)
-from tb3_sim_nav.pacing import Pacer  # noqa: E402
-from tb3_sim_nav.ros.publishers import Publishers  # noqa: E402
-from tb3_sim_nav.ros.rospy_internals import stop_following_clock  # noqa: E402
-from tb3_sim_nav.throttle import Throttle  # noqa: E402
-from tb3_sim_nav.world import World  # noqa: E402
+HERE = os.path.dirname(os.path.abspath(__file__))
 
 PHYSICS_RATE = 100.0  # Hz, the simulator's default
 

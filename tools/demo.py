@@ -37,7 +37,8 @@ for each script does what the tutorial does: start the simulator fresh
 (`roslaunch tb3_sim_bringup tb3_empty_world.launch real_time_factor:=F
 paused:=true`), `rosrun tb3_sim_nav SCRIPT`, unpause once the script has
 connected, stop the simulator (Ctrl+C to roslaunch). Meanwhile it records
-base_pose_ground_truth and odom, and at the end prints a table per script, writes it to OUTPUT/summary.txt and draws the paths
+base_pose_ground_truth and odom, and at the end prints a table per script, writes it to OUTPUT/summary.txt
+and draws the paths
 to OUTPUT/demo_paths.png. Each process's output goes to OUTPUT/logs/.
 
 Exit status 0 if every script ran and exited 0; everything started here is

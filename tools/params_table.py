@@ -3,7 +3,6 @@
 each field's doc, else the comment on its line)."""
 import dataclasses
 import inspect
-import os
 import re
 import sys
 

@@ -46,6 +46,15 @@ lint() {
 }
 export -f lint
 
+# ruff (tools/ruff.toml) on every python file of ours: the .py files, and the scripts without the suffix.
+ruff_lint() {
+  local scripts
+  scripts=$(for file in $(find scripts packages/*/scripts packages/*/nodes -type f ! -name '*.py' 2>/dev/null); do
+    head -c 64 "$file" | grep -q python && echo "$file"; done)
+  ruff check --config tools/ruff.toml . $scripts
+}
+export -f ruff_lint
+
 # The plan (tb3_harness/parts.py starts, whenever slots are free, the first
 # part in this order that fits): the parts that run alone first, while the
 # machine is empty; then Ctrl+C's; the rostests, the longest part of one
@@ -121,6 +130,7 @@ for test_file in test/system/test_*.py; do
   [[ "$planned" == *" $name "* ]] || part 1 "$name" "$pytest $test_file"
 done
 [ -n "$integration_only" ] || part 1 catkin_lint lint
+[ -n "$integration_only" ] || part 1 ruff ruff_lint
 
 if [ -n "$plan_only" ]; then cat "$plan"; rm -rf "$logs"; exit 0; fi
 python3 -m tb3_harness.parts "$plan" "$logs"

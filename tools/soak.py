@@ -23,6 +23,7 @@ import sys
 import time
 
 import bench_sim
+
 from tb3_harness import leftovers
 from tb3_harness.measure import machine, memory_mib, sim_pid
 from tb3_harness.processes import Process, RunError, say, start_master, wait_until
@@ -52,8 +53,8 @@ class Checker(object):
     def __init__(self):
         import rospy
         from nav_msgs.msg import Odometry
-        from tf2_msgs.msg import TFMessage
         from rosgraph_msgs.msg import Clock
+        from tf2_msgs.msg import TFMessage
         self.clock = None
         self.tf_per_second = {}
         self.non_finite = []

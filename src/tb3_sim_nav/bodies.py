@@ -13,7 +13,8 @@ from .frames import IDENTITY, compose, inverse, matrix
 from .model_files import urdf_collisions
 from .robot_model import LEFT_WHEEL_JOINT, RIGHT_WHEEL_JOINT, urdf_text_for_pybullet
 
-BODY_FRICTION = 0.2  # plastic plates against a wall; at 0.3 a robot pushing a wall at an angle stick-slips (doc/design.md)
+#: Plastic plates against a wall; at 0.3 a robot pushing a wall at an angle stick-slips (doc/design.md).
+BODY_FRICTION = 0.2
 
 
 def int32(bits):

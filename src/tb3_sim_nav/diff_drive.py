@@ -5,6 +5,8 @@ Plain floats in, plain floats out; SI units (m, rad, s) throughout.
 import math
 from collections import namedtuple
 
+from tb3_common.pose2d import normalize_angle
+
 Limits = namedtuple('Limits', 'max_linear max_angular')
 
 #: TurtleBot3 Burger, from ROBOTIS' specification and firmware.
@@ -52,12 +54,6 @@ def body_twist(left, right, wheel_radius, wheel_separation):
             wheel_radius * (right - left) / wheel_separation)
 
 
-def wrap_angle(angle):
-    """`angle` (rad) in (-pi, pi]."""
-    wrapped = math.atan2(math.sin(angle), math.cos(angle))
-    return math.pi if wrapped == -math.pi else wrapped
-
-
 class EncoderOdometry(object):
     """Dead reckoning from wheel angles, as the TurtleBot3 firmware does it.
 
@@ -88,7 +84,7 @@ class EncoderOdometry(object):
             heading = self.yaw + turn / 2.0
             self.x += distance * math.cos(heading)
             self.y += distance * math.sin(heading)
-            self.yaw = wrap_angle(self.yaw + turn)
+            self.yaw = normalize_angle(self.yaw + turn)
         self._last_angles = (left_angle, right_angle)
         return self.x, self.y, self.yaw
 

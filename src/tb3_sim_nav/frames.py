@@ -8,6 +8,7 @@ written once for the whole project, in tb3_common.pose2d.
 import math
 
 import numpy as np
+
 from tb3_common.pose2d import quaternion_of_yaw, yaw_of_quaternion
 
 IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))

@@ -11,8 +11,18 @@ limits default to the robot model's own (its URDF's <drive_limits>).
 import dataclasses
 from typing import Optional
 
-from tb3_common.params import (ParameterError, checked, fail, frame_id, non_negative, number, one_of,  # noqa: F401
-                               optional_frame_id, parameter, positive)
+from tb3_common.params import (
+    ParameterError,
+    checked,
+    fail,
+    frame_id,
+    non_negative,
+    number,
+    one_of,
+    optional_frame_id,
+    parameter,
+    positive,
+)
 
 from .robot import KINDS
 from .robot_model import model_problem
@@ -63,10 +73,18 @@ def _p(default, doc, check=None, unit='', origin=None, live=False):
 @dataclasses.dataclass(frozen=True)
 class Config(object):
     """Every parameter of the simulator node, resolved and checked."""
-    model: str = _p('burger', 'the robot (when ~robots is empty): burger, waffle, waffle_pi or the path of a URDF; its geometry, limits and cameras come from its URDF', _model)
-    robots: tuple = _p((), 'robots with namespaces, instead of the one robot of ~model: a list of {name, model, position: [x, y(, z)], yaw} as in world files', _robots)
-    world: str = _p('empty', "world by name (worlds/NAME.yaml) or path to a world file or to a map_server map's YAML (its occupied cells become walls)")
-    map_wall_height: float = _p(0.5, 'height of the walls a map world raises on its occupied cells (above the lidar: Burger 0.182 m)', positive, 'm')
+    model: str = _p('burger',
+                    'the robot (when ~robots is empty): burger, waffle, waffle_pi or the path of a URDF; its geometry,'
+                    ' limits and cameras come from its URDF', _model)
+    robots: tuple = _p((),
+                       'robots with namespaces, instead of the one robot of ~model: a list of {name, model, position: '
+                       '[x, y(, z)], yaw} as in world files', _robots)
+    world: str = _p('empty',
+                    "world by name (worlds/NAME.yaml) or path to a world file or to a map_server map's YAML (its "
+                    'occupied cells become walls)')
+    map_wall_height: float = _p(0.5,
+                                'height of the walls a map world raises on its occupied cells (above the lidar: Burger'
+                                ' 0.182 m)', positive, 'm')
     x_pos: float = _p(0.0, 'spawn position x', unit='m')
     y_pos: float = _p(0.0, 'spawn position y', unit='m')
     z_pos: float = _p(0.0, 'spawn height of base_footprint', unit='m')
@@ -74,20 +92,41 @@ class Config(object):
     gui: bool = _p(False, "open pybullet's own window (needs a display)")
     real_time_factor: float = _p(1.0, 'simulated seconds per wall second; 0 = as fast as possible', non_negative)
     paused: bool = _p(False, 'start with physics paused (/gazebo/unpause_physics resumes)')
-    physics_rate: float = _p(100.0, 'physics steps per simulated second; /clock is published every step (Gazebo publishes it at 100 Hz)', positive, 'Hz')
-    lockstep: bool = _p(True, 'hold each step until the local nodes publishing cmd_vel have reacted to it, so their commands land at the same sim time at any factor')
-    lockstep_timeout: float = _p(0.5, 'longest a step waits for such a node; one that takes longer is not waited for until it waits again', positive, 's (wall)')
-    startup_hold: float = _p(0.3, 'sim time holds this long when a node subscribes to /clock, so it can connect first', non_negative, 's (wall)')
+    physics_rate: float = _p(100.0,
+                             'physics steps per simulated second; /clock is published every step (Gazebo publishes it '
+                             'at 100 Hz)', positive, 'Hz')
+    lockstep: bool = _p(True,
+                        'hold each step until the local nodes publishing cmd_vel have reacted to it, so their commands'
+                        ' land at the same sim time at any factor')
+    lockstep_timeout: float = _p(0.5,
+                                 'longest a step waits for such a node; one that takes longer is not waited for until '
+                                 'it waits again', positive, 's (wall)')
+    startup_hold: float = _p(0.3, 'sim time holds this long when a node subscribes to /clock, so it can connect first',
+                             non_negative, 's (wall)')
     odom_rate: float = _p(30.0, 'rate of odom, tf and base_pose_ground_truth (sim time)', positive, 'Hz')
     joint_states_rate: float = _p(30.0, 'rate of joint_states (sim time)', positive, 'Hz')
-    max_linear_speed: Optional[float] = _p(None, "commands beyond this are clamped; unset: the model's, from its URDF's <drive_limits> (burger 0.22, waffle and waffle_pi 0.26)", positive, 'm/s', FROM_MODEL)
-    max_angular_speed: Optional[float] = _p(None, "the same for turning (burger 2.84, waffle and waffle_pi 1.82)", positive, 'rad/s', FROM_MODEL)
+    max_linear_speed: Optional[float] = _p(None,
+                                           "commands beyond this are clamped; unset: the model's, from its URDF's "
+                                           '<drive_limits> (burger 0.22, waffle and waffle_pi 0.26)',
+                                           positive, 'm/s', FROM_MODEL)
+    max_angular_speed: Optional[float] = _p(None, 'the same for turning (burger 2.84, waffle and waffle_pi 1.82)',
+                                            positive, 'rad/s', FROM_MODEL)
     wheel_torque: float = _p(1.5, 'stall torque of each wheel motor (Dynamixel XL430 at 12 V)', positive, 'N m')
-    wheel_acceleration: float = _p(1.0, "limit on each wheel rim's acceleration, as TurtleBot3's Gazebo set-up (wheelAcceleration 1); 0 = none", non_negative, 'm/s^2', live=True)
-    odom_frame: str = _p('odom', 'frame of odom and of its tf parent (a robot with a name gets it as a prefix: tb3_0/odom)', frame_id)
+    wheel_acceleration: float = _p(1.0, "limit on each wheel rim's acceleration, as TurtleBot3's Gazebo set-up "
+                                   '(wheelAcceleration 1); 0 = none', non_negative, 'm/s^2', live=True)
+    odom_frame: str = _p('odom',
+                         'frame of odom and of its tf parent (a robot with a name gets it as a prefix: tb3_0/odom)',
+                         frame_id)
     base_frame: str = _p('base_footprint', 'child frame of odom and its tf (prefixed as odom_frame)', frame_id)
-    world_frame: str = _p('world', "the world's frame: the simulator publishes tf from it to each robot's odom frame (the truth: the identity while odom is the true pose, the drift of encoder odometry otherwise) and draws the world's obstacles in it on world_markers; empty: neither (when a localization node publishes odom's parent)", optional_frame_id)
-    robot_state_publisher: bool = _p(True, 'publish what a robot_state_publisher with tf_prefix would for each robot with a name (its fixed joints on /tf_static, its wheels on /tf); false: only set NAME/robot_description, for nodes of your own')
+    world_frame: str = _p('world',
+                          "the world's frame: the simulator publishes tf from it to each robot's odom frame (the "
+                          'truth: the identity while odom is the true pose, the drift of encoder odometry otherwise) '
+                          "and draws the world's obstacles in it on world_markers; empty: neither (when a localization"
+                          " node publishes odom's parent)", optional_frame_id)
+    robot_state_publisher: bool = _p(True,
+                                     'publish what a robot_state_publisher with tf_prefix would for each robot with a '
+                                     'name (its fixed joints on /tf_static, its wheels on /tf); false: only set '
+                                     'NAME/robot_description, for nodes of your own')
     scan: bool = _p(True, 'publish the LDS-01 lidar on scan')
     scan_rate: float = _p(5.0, 'scan rate (sim time)', positive, 'Hz')
     scan_samples: int = _p(360, 'beams per turn', number(3))
@@ -95,26 +134,52 @@ class Config(object):
     scan_range_max: float = _p(3.5, 'beams reaching no wall within it read +inf', positive, 'm')
     scan_noise: float = _p(0.01, 'standard deviation of Gaussian range noise; 0 = none', non_negative, 'm', live=True)
     imu: bool = _p(True, 'publish the IMU on imu')
-    imu_rate: float = _p(100.0, 'IMU rate (sim time); at most ~physics_rate: the real Burger and its Gazebo model give 200 Hz, with ~physics_rate 200', positive, 'Hz')
-    camera_width: Optional[int] = _p(None, 'image width of the Waffle (Pi) camera; unset: the model\'s, at most 640 (the height follows the model\'s aspect)', number(1, 4096), 'pixels', FROM_MODEL)
-    camera_height: Optional[int] = _p(None, 'image height (unset: from the width and the model\'s aspect)', number(1, 4096), 'pixels', FROM_MODEL)
-    camera_horizontal_fov: Optional[float] = _p(None, "horizontal field of view; unset: the model's (waffle 1.3439, waffle_pi 1.085595)", number(0.1, 3.0), 'rad', FROM_MODEL)
-    camera_rate: Optional[float] = _p(None, "camera rate (sim time), at most ~physics_rate; unset: the model's (Gazebo's 30), at most 15, to keep real time with rviz on 2 cores", positive, 'Hz', FROM_MODEL)
+    imu_rate: float = _p(100.0,
+                         'IMU rate (sim time); at most ~physics_rate: the real Burger and its Gazebo model give 200 '
+                         'Hz, with ~physics_rate 200', positive, 'Hz')
+    camera_width: Optional[int] = _p(None,
+                                     "image width of the Waffle (Pi) camera; unset: the model's, at most 640 (the "
+                                     "height follows the model's aspect)", number(1, 4096), 'pixels', FROM_MODEL)
+    camera_height: Optional[int] = _p(None, "image height (unset: from the width and the model's aspect)",
+                                      number(1, 4096), 'pixels', FROM_MODEL)
+    camera_horizontal_fov: Optional[float] = _p(None, "horizontal field of view; unset: the model's (waffle 1.3439, "
+                                                'waffle_pi 1.085595)', number(0.1, 3.0), 'rad', FROM_MODEL)
+    camera_rate: Optional[float] = _p(None,
+                                      "camera rate (sim time), at most ~physics_rate; unset: the model's (Gazebo's "
+                                      '30), at most 15, to keep real time with rviz on 2 cores',
+                                      positive, 'Hz', FROM_MODEL)
     seed: int = _p(-1, 'seed of every noise source; -1 = different each run', number(-1))
     profile: str = _p('gazebo', 'realism profile: chooses the defaults below', one_of(*sorted(PROFILES)))
-    odom_source: str = _p(None, 'odom from the true pose (Gazebo) or integrated from wheel encoders (firmware)', one_of('world', 'encoders'), origin=FROM_PROFILE)
+    odom_source: str = _p(None, 'odom from the true pose (Gazebo) or integrated from wheel encoders (firmware)',
+                          one_of('world', 'encoders'), origin=FROM_PROFILE)
     ground_friction: float = _p(None, 'Coulomb friction of wheel on ground', positive, origin=FROM_PROFILE, live=True)
-    caster_friction: float = _p(None, 'Coulomb friction of the ball caster on ground (drags when turning)', non_negative, origin=FROM_PROFILE, live=True)
-    left_motor_error: float = _p(None, 'the left wheel turns this much faster than commanded (negative: slower), as a loaded motor does', _fraction, 'fraction', FROM_PROFILE, live=True)
+    caster_friction: float = _p(None, 'Coulomb friction of the ball caster on ground (drags when turning)',
+                                non_negative, origin=FROM_PROFILE, live=True)
+    left_motor_error: float = _p(None,
+                                 'the left wheel turns this much faster than commanded (negative: slower), as a loaded'
+                                 ' motor does', _fraction, 'fraction', FROM_PROFILE, live=True)
     right_motor_error: float = _p(None, 'the same for the right wheel', _fraction, 'fraction', FROM_PROFILE, live=True)
-    odom_wheel_radius_error: float = _p(None, 'encoder odometry assumes a wheel this much bigger than the real one', _fraction, 'fraction', FROM_PROFILE, live=True)
-    odom_wheel_separation_error: float = _p(None, 'encoder odometry assumes wheels this much further apart than they act', _fraction, 'fraction', FROM_PROFILE, live=True)
-    odom_linear_scale_correction: float = _p(1.0, "encoder odometry's distances are multiplied by this, as a base controller's calibration (ROS by Example's calibrate_linear.py measures it); the gazebo profile's odometry is the true pose and ignores it", _correction, 'factor', live=True)
-    odom_angular_scale_correction: float = _p(1.0, "encoder odometry's turns are multiplied by this (calibrate_angular.py)", _correction, 'factor', live=True)
-    encoder_noise: float = _p(None, 'standard deviation of Gaussian noise on each wheel-angle reading', non_negative, 'rad', FROM_PROFILE, live=True)
-    cmd_vel_timeout: float = _p(None, 'stop when no cmd_vel came for this long (firmware: 0.5); 0 = hold the last command forever', non_negative, 's', FROM_PROFILE, live=True)
-    imu_gyro_noise: float = _p(None, 'standard deviation of angular-velocity noise', non_negative, 'rad/s', FROM_PROFILE, live=True)
-    imu_accel_noise: float = _p(None, 'standard deviation of linear-acceleration noise', non_negative, 'm/s^2', FROM_PROFILE, live=True)
+    odom_wheel_radius_error: float = _p(None, 'encoder odometry assumes a wheel this much bigger than the real one',
+                                        _fraction, 'fraction', FROM_PROFILE, live=True)
+    odom_wheel_separation_error: float = _p(None,
+                                            'encoder odometry assumes wheels this much further apart than they act',
+                                            _fraction, 'fraction', FROM_PROFILE, live=True)
+    odom_linear_scale_correction: float = _p(1.0, "encoder odometry's distances are multiplied by this, as a base "
+                                             "controller's calibration (ROS by Example's calibrate_linear.py measures "
+                                             "it); the gazebo profile's odometry is the true pose and ignores it",
+                                             _correction, 'factor', live=True)
+    odom_angular_scale_correction: float = _p(1.0,
+                                              "encoder odometry's turns are multiplied by this (calibrate_angular.py)",
+                                              _correction, 'factor', live=True)
+    encoder_noise: float = _p(None, 'standard deviation of Gaussian noise on each wheel-angle reading',
+                              non_negative, 'rad', FROM_PROFILE, live=True)
+    cmd_vel_timeout: float = _p(None,
+                                'stop when no cmd_vel came for this long (firmware: 0.5); 0 = hold the last command '
+                                'forever', non_negative, 's', FROM_PROFILE, live=True)
+    imu_gyro_noise: float = _p(None, 'standard deviation of angular-velocity noise',
+                               non_negative, 'rad/s', FROM_PROFILE, live=True)
+    imu_accel_noise: float = _p(None, 'standard deviation of linear-acceleration noise',
+                                non_negative, 'm/s^2', FROM_PROFILE, live=True)
 
     def replace(self, **changes):
         """A copy with `changes` (unchecked: for tests and tools)."""

@@ -1,4 +1,5 @@
-"""Rays against boxes, cylinders, spheres and the ground, in numpy: the world's still shapes and its robots'. No pybullet.
+"""Rays against boxes, cylinders, spheres and the ground, in numpy: the world's still shapes and its robots'.
+No pybullet.
 
 Why not pybullet's rayTestBatch for everything: it costs 0.4 us a ray even
 where nothing is, and Bullet tests a ray against a box or cylinder by a

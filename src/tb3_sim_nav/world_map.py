@@ -12,6 +12,7 @@ outline of each obstacle).
 import math
 
 import numpy as np
+
 from tb3_common.grid import FREE, OCCUPIED, UNKNOWN, Grid
 
 BURGER_SCAN_HEIGHT = 0.182  # m: base_scan above the ground on the Burger (and lower on the Waffles: 0.132)

@@ -1,4 +1,5 @@
-"""world_to_map WORLD -f NAME [--start X Y] [--resolution 0.05]: a world file rasterised into a map_server map. No master needed.
+"""world_to_map WORLD -f NAME [--start X Y] [--resolution 0.05]: a world file rasterised into a map_server map.
+No master needed.
 
 The map is the world cut at the Burger's lidar height (world_map.map_of_world:
 a cell is occupied if an obstacle covers any of it, free otherwise), over the

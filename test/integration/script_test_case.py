@@ -9,8 +9,7 @@ import unittest
 
 import rospy
 
-from tb3_test_utils import (Child, GroundTruth, in_frame_of, report, unwrapped_turn,
-                            wall_budget, wrap)
+from tb3_test_utils import Child, GroundTruth, in_frame_of, report, unwrapped_turn, wall_budget, wrap
 
 
 class ScriptTestCase(unittest.TestCase):

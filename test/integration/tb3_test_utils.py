@@ -17,6 +17,7 @@ from collections import namedtuple
 
 import rospy
 from nav_msgs.msg import Odometry
+
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.realpath(__file__)), '..', '..', 'tools'))  # the harness
 from tb3_harness.processes import Process
 

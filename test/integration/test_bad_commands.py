@@ -26,8 +26,16 @@ from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Log
 from tf2_msgs.msg import TFMessage
 
-from tb3_test_utils import (GroundTruth, all_finite, finite_difference_speeds, init_test_node,
-                            report, speed, wait_for, wall_budget)
+from tb3_test_utils import (
+    GroundTruth,
+    all_finite,
+    finite_difference_speeds,
+    init_test_node,
+    report,
+    speed,
+    wait_for,
+    wall_budget,
+)
 
 MAX_V, MAX_W = 0.22, 2.84
 SLACK = 1.05

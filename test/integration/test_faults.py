@@ -26,8 +26,16 @@ import rostest
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 
-from tb3_test_utils import (Child, GroundTruth3D, finite_difference_speeds, init_test_node, report,
-                            speed, wait_for, wall_budget)
+from tb3_test_utils import (
+    Child,
+    GroundTruth3D,
+    finite_difference_speeds,
+    init_test_node,
+    report,
+    speed,
+    wait_for,
+    wall_budget,
+)
 
 SIM_NODE = '/tb3_sim'
 MAX_V, MAX_W = 0.22, 2.84

@@ -10,8 +10,8 @@ the robot must stand still (< 1 cm/s) from 0.5 s (the timeout) + 0.3 s
 import signal
 
 import rostest
+from test_faults import STOPPED_SPEED, FaultsBase
 
-from test_faults import FaultsBase, STOPPED_SPEED
 from tb3_test_utils import init_test_node, report, speed, wall_budget
 
 TIMEOUT = 0.5                 # s, ~cmd_vel_timeout of the realistic profile

@@ -29,8 +29,16 @@ import rospy
 import rostest
 import yaml
 from gazebo_msgs.msg import ModelState, ModelStates
-from gazebo_msgs.srv import (DeleteModel, GetModelProperties, GetModelState, GetPhysicsProperties,
-                             GetWorldProperties, SetModelState, SetPhysicsProperties, SpawnModel)
+from gazebo_msgs.srv import (
+    DeleteModel,
+    GetModelProperties,
+    GetModelState,
+    GetPhysicsProperties,
+    GetWorldProperties,
+    SetModelState,
+    SetPhysicsProperties,
+    SpawnModel,
+)
 from geometry_msgs.msg import Pose, Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import LaserScan

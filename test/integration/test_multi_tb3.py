@@ -40,8 +40,17 @@ from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState, LaserScan
 from std_srvs.srv import Empty
 
-from tb3_test_utils import (GroundTruth, Repeater, init_test_node, report, turn_to, wait_for,
-                            wait_for_simulator, wall_budget, wrap)
+from tb3_test_utils import (
+    GroundTruth,
+    Repeater,
+    init_test_node,
+    report,
+    turn_to,
+    wait_for,
+    wait_for_simulator,
+    wall_budget,
+    wrap,
+)
 
 SPAWN = {'tb3_0': (-2.0, -0.5, 0.0), 'tb3_1': (-2.0, 0.5, 0.0), 'tb3_2': (-1.5, 1.6, -0.8)}
 ROBOTS = sorted(SPAWN)

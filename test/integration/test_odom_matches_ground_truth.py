@@ -23,8 +23,7 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from tf2_msgs.msg import TFMessage
 
-from tb3_test_utils import (wait_for_simulator, GroundTruth, init_test_node, report, wait_for, wall_budget,
-                            wrap)
+from tb3_test_utils import GroundTruth, init_test_node, report, wait_for, wait_for_simulator, wall_budget, wrap
 
 POSITION_TOLERANCE = 0.001            # m
 ANGLE_TOLERANCE = math.radians(0.1)   # rad

@@ -21,8 +21,7 @@ from geometry_msgs.msg import Twist
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty
 
-from tb3_test_utils import (GroundTruth, init_test_node, real_time_factor, report, speed,
-                            wait_for, wall_budget)
+from tb3_test_utils import GroundTruth, init_test_node, real_time_factor, report, speed, wait_for, wall_budget
 
 PAUSED_WALL_SECONDS = 2.0
 DRIVE = (0.1, 0.3)

@@ -29,8 +29,22 @@ from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty
 
 from script_test_case import ScriptTestCase
-from tb3_test_utils import (wait_for_simulator, Child, GroundTruth, Sample, after_jump_back, in_frame_of, init_test_node,
-                            report, speed, unwrapped_turn, wait_for, wall_budget, wrap, yaw_of)
+from tb3_test_utils import (
+    Child,
+    GroundTruth,
+    Sample,
+    after_jump_back,
+    in_frame_of,
+    init_test_node,
+    report,
+    speed,
+    unwrapped_turn,
+    wait_for,
+    wait_for_simulator,
+    wall_budget,
+    wrap,
+    yaw_of,
+)
 
 SPAWN = Sample(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 POSITION_TOLERANCE = 0.01    # m

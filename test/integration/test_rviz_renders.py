@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""rviz with the tutorial's demo.rviz, on a screen of its own, shows what the learner must see.
+r"""rviz with the tutorial's demo.rviz, on a screen of its own, shows what the learner must see.
 
 The .test includes tb3_world.launch (arena, pillars, spawn at (-2, -0.5)). This
 node starts Xvfb on a free display (Xvfb picks it: -displayfd) and rviz as the
@@ -38,6 +38,7 @@ import rospy
 import rostest
 import yaml
 from geometry_msgs.msg import Twist
+
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.realpath(__file__)), '..', '..', 'tools'))  # the harness
 from tb3_harness.screen import green_pixels, save_png, screenshot, start_xvfb
 

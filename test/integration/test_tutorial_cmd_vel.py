@@ -20,8 +20,17 @@ import rospy
 import rostest
 from geometry_msgs.msg import Twist
 
-from tb3_test_utils import (Child, GroundTruth, in_frame_of, init_test_node, report, speed,
-                            unwrapped_turn, wall_budget, wait_for)
+from tb3_test_utils import (
+    Child,
+    GroundTruth,
+    in_frame_of,
+    init_test_node,
+    report,
+    speed,
+    unwrapped_turn,
+    wait_for,
+    wall_budget,
+)
 
 CIRCLE_COMMAND = ['rostopic', 'pub', '-r', '10', '/cmd_vel', 'geometry_msgs/Twist',
                   '{linear: {x: 0.1, y: 0, z: 0}, angular: {x: 0, y: 0, z: -0.5}}']

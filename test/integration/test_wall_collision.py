@@ -22,8 +22,18 @@ import rospy
 import rostest
 from geometry_msgs.msg import Twist
 
-from tb3_test_utils import (wait_for_simulator, GroundTruth3D, Repeater, finite_difference_speeds, init_test_node,
-                            report, speed, turn_to, wall_budget, wrap)
+from tb3_test_utils import (
+    GroundTruth3D,
+    Repeater,
+    finite_difference_speeds,
+    init_test_node,
+    report,
+    speed,
+    turn_to,
+    wait_for_simulator,
+    wall_budget,
+    wrap,
+)
 
 WALL_FACE_X = -2.5            # inner face of the west wall (m)
 WALL_Y_EXTENT = 1.49          # the west wall spans |y| below this (m)

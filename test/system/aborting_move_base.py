@@ -5,7 +5,6 @@
 It prints one line per goal it aborts, so the test can count them.
 """
 import actionlib
-import rospy
 from move_base_msgs.msg import MoveBaseAction, MoveBaseResult
 
 from tb3_common.ros import lifecycle

@@ -18,6 +18,7 @@ import time
 import pytest
 
 from tb3_harness import leftovers
+
 from tb3_system_utils import alive, run, wait_until
 
 PRESSES = 20

@@ -35,6 +35,7 @@ from tb3_harness.map_quality import measure
 from tb3_harness.report import figure
 from tb3_harness.screen import save_png, screenshot, start_xvfb
 from tb3_harness.waypoints import WORLD_LOOP_START
+
 from tb3_system_utils import run, wait_until
 
 TIMEOUT = 60.0

@@ -17,14 +17,14 @@ import os
 import re
 import time
 
+from test_emanual import FLOOR, SHOTS, WALL, colour_pixels, map_view
+
 from tb3_harness import exploring
 from tb3_harness.mapping import _node_pid
 from tb3_harness.measure import cpu_seconds
 from tb3_harness.processes import Process, start_master, wait_until
 from tb3_harness.report import figure, map_figures
 from tb3_harness.screen import save_png, screenshot, start_xvfb
-
-from test_emanual import FLOOR, SHOTS, WALL, colour_pixels, map_view
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 BOXED_IN = os.path.join(HERE, '..', 'data', 'worlds', 'boxed_in.yaml')

@@ -5,6 +5,7 @@ shows the pillars of turtlebot3_world that the robot faces at its spawn pose
 import os
 
 from tb3_harness.screen import green_pixels, save_png, screenshot, start_xvfb
+
 from tb3_system_utils import wait_until
 
 MIN_GREEN = 1000  # pillar pixels in the window (a 640 x 480 image shows tens of thousands)

@@ -14,8 +14,8 @@ import time
 import numpy as np
 import pytest
 
-from tb3_harness.processes import Process, start_master
 from tb3_common.map_files import load_map
+from tb3_harness.processes import Process, start_master
 
 from tb3_system_utils import run, wait_until
 

@@ -21,13 +21,14 @@ import rosgraph
 import rospkg
 import yaml
 
+from tb3_common.map_files import load_map
 from tb3_harness import exploring
 from tb3_harness.map_quality import measure
 from tb3_harness.navigating import BURGER_FOOTPRINT, clearance
 from tb3_harness.processes import Process, start_master, wait_until
 from tb3_harness.report import figure
-from tb3_common.map_files import load_map
 from tb3_sim_nav.world_file import load_world
+
 from tb3_system_utils import ROBOTS
 
 EXPLORE_SIM_SECONDS = 60.0   # of exploration each robot gets (sim time of its explorer's goals)

@@ -13,6 +13,7 @@ import os
 import subprocess
 
 from tb3_harness.processes import free_port
+
 from tb3_system_utils import master_uri, wait_until
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -34,7 +35,8 @@ def test_the_readme_block_builds_a_workspace_that_runs_the_simulator(tmp_path, p
                           ROS_MASTER_URI=master_uri(port), ROS_HOSTNAME='localhost')
     script = BLOCK.replace(ADDRESS, REPO) + '\nset -e\n' + '\n'.join([
         'rospack find tb3_sim_nav', 'rospack find tb3_sim_bringup',
-        'python3 -c "import gazebo_msgs.srv, tb3_common, tb3_navigation, tb3_sim_nav; print(gazebo_msgs.srv.__file__)"'])
+        'python3 -c "import gazebo_msgs.srv, tb3_common, tb3_navigation, tb3_sim_nav; '
+        'print(gazebo_msgs.srv.__file__)"'])
     built = subprocess.run(['bash', '-c', 'set -e\n' + script], env=fresh_terminal, stdout=subprocess.PIPE,
                            stderr=subprocess.STDOUT, universal_newlines=True, timeout=BUILD_TIMEOUT)
     workspace = str(tmp_path / 'catkin_ws')

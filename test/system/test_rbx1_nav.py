@@ -31,12 +31,14 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 BOOK = os.path.join(REPO, 'test', 'data', 'rbx1_nav')
 PYTHON3_FIX = ('sequence = sample(locations, n_locations)', 'sequence = sample(list(locations), n_locations)')
 RVIZ_POSE = ("{header: {frame_id: map}, pose: {pose: {orientation: {w: 1.0}}, covariance: [0.25, 0, 0, 0, 0, 0, "
-             "0, 0.25, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.06853891945]}}")
+             "0, 0.25, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, "
+             "0.06853891945]}}")
 
 
 # The README's commands, as a learner types them (rviz left out: no screen here).
 SQUARE = ['roslaunch tb3_sim_bringup tb3_empty_world.launch',
-          'roslaunch tb3_sim_bringup tb3_navigation.launch map_file:=`rospack find tb3_sim_nav`/maps/rbx1/blank_map.yaml',
+          'roslaunch tb3_sim_bringup tb3_navigation.launch '
+          'map_file:=`rospack find tb3_sim_nav`/maps/rbx1/blank_map.yaml',
           './move_base_square.py']
 TOUR = ['roslaunch tb3_sim_bringup tb3_empty_world.launch world:=`rospack find tb3_sim_nav`/maps/rbx1/test_map.yaml',
         'roslaunch tb3_sim_bringup tb3_navigation.launch map_file:=`rospack find tb3_sim_nav`/maps/rbx1/test_map.yaml',

@@ -16,6 +16,7 @@ import subprocess
 import yaml
 
 from tb3_harness.screen import start_xvfb
+
 from tb3_system_utils import Echo, poses, run, wait_until
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))

@@ -30,8 +30,8 @@ from tb3_common.map_files import load_map
 from tb3_harness.map_quality import measure
 from tb3_harness.screen import save_png, screenshot, start_xvfb
 from tb3_sim_nav.world_file import load_world
-from tb3_system_utils import ROBOTS, wait_until
 
+from tb3_system_utils import ROBOTS, wait_until
 
 
 def _burger(**variables):
@@ -233,7 +233,8 @@ def test_robotis_multi_map_merge_merges_the_three_robots_maps(ros_port, processe
 
     def maps_drawn():
         image = screenshot(display).astype(int)
-        drawn[:] = [image] + [int((np.abs(image - np.array(colour)).max(axis=2) <= 8).sum()) for colour in (WALL, FLOOR)]
+        drawn[:] = [image] + [int((np.abs(image - np.array(colour)).max(axis=2) <= 8).sum())
+                              for colour in (WALL, FLOOR)]
         return drawn[1] > 500 and drawn[2] > 5000
     assert wait_until(maps_drawn, 120.0, poll=1.0), 'rviz draws no map: %s wall and floor pixels' % drawn[1:]
     os.makedirs(SHOTS, exist_ok=True)

@@ -41,8 +41,8 @@ def test_the_slam_corrects_odometry_and_its_map_lies_on_the_walls(runs, factor):
     quality = run.quality
     print('MEASURED factor %g: loop of %.1f m in %.1f s sim, %.1f s wall; pose in map off the truth %.3f m %.2f deg, '
           'odometry %.3f m %.2f deg; SLAM CPU %.0f %% of a core; map: %s'
-          % (factor, mapping.path_length(run.truth), run.sim_seconds, run.wall_seconds, run.map_error[0], run.map_error[1],
-             run.odom_error[0], run.odom_error[1], 100 * run.slam_cpu, quality.summary()))
+          % (factor, mapping.path_length(run.truth), run.sim_seconds, run.wall_seconds, run.map_error[0],
+             run.map_error[1], run.odom_error[0], run.odom_error[1], 100 * run.slam_cpu, quality.summary()))
     figure('slam_pose_error', run.map_error[0], 'max', 'm')
     figure('slam_heading_error', abs(run.map_error[1]), 'max', 'deg')
     map_figures('slam_map', quality)

@@ -21,6 +21,7 @@ import sys
 
 import pytest
 
+from tb3_common.pose2d import normalize_angle
 from tb3_harness import report, tutorial
 from tb3_harness.processes import start_master
 
@@ -77,7 +78,7 @@ def test_script_ends_within_1cm_1deg_at_factors_5_and_0_of_factor_1(script, expe
     for factor in FACTORS[1:]:
         _, x, y, yaw = ends[factor]
         apart = math.hypot(x - x1, y - y1)
-        turned = abs(math.degrees(report.normalize(yaw - yaw1)))
+        turned = abs(math.degrees(normalize_angle(yaw - yaw1)))
         print('MEASURED speed_agreement %s factor %g: apart %.4f m, %.3f deg; ends factor 1 (%+.4f, %+.4f, '
               '%+.2f deg), factor %g (%+.4f, %+.4f, %+.2f deg); wall/sim s factor 1 %.1f/%.1f, factor %g %.1f/%.1f; '
               'lockstep left it behind factor 1 %d, factor %g %d times'

@@ -24,6 +24,7 @@ import time
 
 from tb3_harness.measure import sim_uri
 from tb3_harness.tcpros_reader import TcprosReader
+
 from tb3_system_utils import wait_until
 
 STEP_NS = 10000000            # one physics step (100 Hz)
@@ -80,7 +81,8 @@ def test_a_suspended_reader_costs_only_itself(ros_port, processes):
                                                env=dict(os.environ, PYTHONUNBUFFERED='1')))
                       for topic in ('/scan', '/imu'))
         for topic, echo in echoes.items():
-            assert wait_until(lambda: newest_stamp(echo.log) is not None, 60.0), 'rostopic echo %s printed nothing' % topic
+            assert wait_until(lambda: newest_stamp(echo.log) is not None, 60.0), \
+                'rostopic echo %s printed nothing' % topic
         start_wall, start_sim = time.monotonic(), clock.now()
         time.sleep(5.0)
         pace = (clock.now() - start_sim) / (time.monotonic() - start_wall)

@@ -16,8 +16,8 @@ it fails.
 """
 import math
 import os
-import re
 import pty
+import re
 import select
 import signal
 import subprocess
@@ -386,7 +386,8 @@ def test_a_killed_roslaunch_leaves_no_teleop_behind(master, processes, tmp_path,
 
 
 def test_in_a_namespace_it_drives_one_robot_of_three(master, processes, tmp_path, monkeypatch):
-    """multi_turtlebot3.launch, then the e-manual's `ROS_NAMESPACE=tb3_0 rosrun turtlebot3_teleop turtlebot3_teleop_key`:
+    """multi_turtlebot3.launch, then the e-manual's
+    `ROS_NAMESPACE=tb3_0 rosrun turtlebot3_teleop turtlebot3_teleop_key`:
     tb3_0 (facing +y) drives ahead on /tb3_0/cmd_vel, tb3_1 does not move."""
     monkeypatch.setenv('TURTLEBOT3_MODEL', 'burger')
     sim = processes.start('sim', MULTI)

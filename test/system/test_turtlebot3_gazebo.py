@@ -26,6 +26,7 @@ import rospkg
 from tb3_harness import leftovers
 from tb3_harness.navigating import BURGER_FOOTPRINT, clearance
 from tb3_harness.screen import save_png, screenshot, start_xvfb
+
 from tb3_system_utils import Echo, alive, poses, run, wait_until
 
 EXPORT = 'export TURTLEBOT3_MODEL=burger'

@@ -30,8 +30,10 @@ import subprocess
 
 import pytest
 
+from tb3_common.pose2d import yaw_of_quaternion
 from tb3_harness import report
 from tb3_harness.processes import free_port
+
 from tb3_system_utils import wait_until
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -137,7 +139,7 @@ def poses(log):
             row = dict(zip(header, line.split(',')))
             value = lambda name: float(row['field.pose.pose.' + name])  # noqa: E731
             rows.append((int(row['field.header.stamp']) * 1e-9, value('position.x'), value('position.y'),
-                         report.yaw_of(value('orientation.x'), value('orientation.y'),
+                         yaw_of_quaternion(value('orientation.x'), value('orientation.y'),
                                        value('orientation.z'), value('orientation.w'))))
     return rows
 

@@ -3,13 +3,14 @@ import math
 
 import pytest
 
+from tb3_common.pose2d import normalize_angle
 from tb3_harness import calibration, report
 from tb3_harness.processes import RunError
 
 
 def turning_path(degrees, steps=90, start=0.0, x=0.0):
     """(stamp, x, y, yaw) samples of a turn in place by `degrees`, one per 0.1 s."""
-    return [(start + 0.1 * i, x, 0.0, report.normalize(math.radians(degrees * i / steps))) for i in range(steps + 1)]
+    return [(start + 0.1 * i, x, 0.0, normalize_angle(math.radians(degrees * i / steps))) for i in range(steps + 1)]
 
 
 def test_measure_sums_the_turn_through_the_wrap_around():

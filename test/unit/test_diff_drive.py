@@ -5,8 +5,15 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
-from tb3_sim_nav.diff_drive import (BURGER_LIMITS, EncoderOdometry, Limits, body_twist,
-                                    sanitize_twist, wheel_speeds, wrap_angle)
+from tb3_common.pose2d import normalize_angle
+from tb3_sim_nav.diff_drive import (
+    BURGER_LIMITS,
+    EncoderOdometry,
+    Limits,
+    body_twist,
+    sanitize_twist,
+    wheel_speeds,
+)
 from tb3_sim_nav.frames import quaternion_of_yaw, yaw_of
 
 RADIUS, SEPARATION = 0.033, 0.160
@@ -122,8 +129,8 @@ def test_wheel_speeds_and_body_twist_round_trip(v, w, radius, separation):
 @example(math.pi)
 @example(-math.pi)
 def test_yaw_of_inverts_quaternion_of_yaw_in_half_open_interval_once_wrapped(yaw):
-    back = wrap_angle(yaw_of(quaternion_of_yaw(yaw)))
-    assert -math.pi < back <= math.pi, 'documented range is (-pi, pi]'
+    back = normalize_angle(yaw_of(quaternion_of_yaw(yaw)))
+    assert -math.pi <= back < math.pi, 'documented range is [-pi, pi)'
     assert math.remainder(back - yaw, 2 * math.pi) == pytest.approx(0.0, abs=1e-12)
 
 
@@ -172,13 +179,14 @@ def test_encoder_odometry_in_place_turn_wraps_yaw_into_half_open_interval():
 
 
 @pytest.mark.parametrize('w', [1.0, -1.0], ids=['left', 'right'])
-def test_encoder_odometry_half_turn_reads_plus_pi(w):
-    """(-pi, pi] holds at its edge: half a turn either way reads +pi, never -pi."""
+def test_encoder_odometry_half_turn_reads_pi(w):
+    """The project's one angle wrap ([-pi, pi), tb3_common.pose2d) holds at its edge: half a turn either way
+    reads pi or -pi, the same heading."""
     left, right = wheel_speeds(0.0, w, RADIUS, SEPARATION)
     odometry = fresh_odometry()
     _x, _y, yaw = odometry.update(left * math.pi, right * math.pi)
-    assert -math.pi < yaw <= math.pi
-    assert yaw == pytest.approx(math.pi, abs=1e-9)
+    assert -math.pi <= yaw < math.pi
+    assert abs(yaw) == pytest.approx(math.pi, abs=1e-9)
 
 
 @pytest.mark.parametrize('v, w', [(0.1, 0.5), (0.1, -0.5), (-0.2, 1.0)])

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from tb3_harness.map_quality import QualityConfig, measure, render_png
 from tb3_common.grid import Grid
 from tb3_common.map_files import load_map
+from tb3_harness.map_quality import QualityConfig, measure, render_png
 from tb3_navigation.raytrace import crossed_cells, end_cells
 from tb3_navigation.scan import Scan
 from tb3_sim_nav.world import World

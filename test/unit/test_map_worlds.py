@@ -41,7 +41,8 @@ def make(burger_urdf):
     def make_simulation(obstacles, pose, **parameters):
         values = dict(scan_noise=0.0, **parameters)
         config = resolve(lambda name, default: values.get(name, default))
-        simulation = build(config, obstacles, [('', load_model(str(burger_urdf)), planar(pose[0], pose[1], 0.0, pose[2]))])
+        robot = ('', load_model(str(burger_urdf)), planar(pose[0], pose[1], 0.0, pose[2]))
+        simulation = build(config, obstacles, [robot])
         made.append(simulation)
         return simulation
     yield make_simulation

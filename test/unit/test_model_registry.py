@@ -2,7 +2,6 @@
 simulation's registry (names, states in other frames, spawns, teleports, deletes)."""
 import math
 
-import pybullet
 import pytest
 
 from tb3_sim_nav.frames import IDENTITY, compose, from_rpy, inverse, relative, rotate

@@ -5,7 +5,7 @@ import math
 import pytest
 
 from tb3_common.params import kind_of
-from tb3_sim_nav.params import FROM_MODEL, FROM_PROFILE, PROFILES, PARAMETERS, ParameterError, resolve
+from tb3_sim_nav.params import FROM_MODEL, FROM_PROFILE, PARAMETERS, PROFILES, ParameterError, resolve
 
 
 @pytest.fixture

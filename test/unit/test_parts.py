@@ -5,7 +5,6 @@ import sys
 
 import pytest
 
-from tb3_harness import parts
 from tb3_harness.parts import Part, PlanError, Schedule, read_plan, why
 
 

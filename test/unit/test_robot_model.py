@@ -3,8 +3,14 @@ import xml.etree.ElementTree as ElementTree
 
 import pytest
 
-from tb3_sim_nav.robot_model import (ModelError, load_model, model_urdf, read_drive_geometry, root_link,
-                                     urdf_for_pybullet)
+from tb3_sim_nav.robot_model import (
+    ModelError,
+    load_model,
+    model_urdf,
+    read_drive_geometry,
+    root_link,
+    urdf_for_pybullet,
+)
 
 WHEEL_LINK = ('<link name="{0}"><collision><geometry><sphere radius="0.033"/></geometry>'
               '</collision></link>')
@@ -182,7 +188,8 @@ def test_models_by_name_are_urdfs_of_the_folder_and_paths_are_paths(tmp_path):
 
 
 def test_an_unknown_model_is_refused_naming_the_three(tmp_path):
-    with pytest.raises(ModelError, match="model 'wafle': unknown TurtleBot3 model: the models are burger, waffle, waffle_pi"):
+    with pytest.raises(ModelError, match="model 'wafle': unknown TurtleBot3 model: the models are burger, "
+                                         "waffle, waffle_pi"):
         model_urdf('wafle', '/pkg/urdf')
 
 
@@ -214,8 +221,8 @@ def _same_pose(a, b):
 
 @pytest.mark.parametrize('model', ['burger', 'waffle', 'waffle_pi'])
 def test_every_joint_of_the_shipped_urdfs_is_where_kdl_puts_it(model):
-    import random
     import os
+    import random
     urdfs = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), 'urdf')
     joints = load_model(model_urdf(model, urdfs)).joints
     assert {joint.name for joint in joints if joint.moving} == {'wheel_left_joint', 'wheel_right_joint'}

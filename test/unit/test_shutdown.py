@@ -93,7 +93,9 @@ def test_a_node_still_running_after_its_end_was_asked_for_prints_where_its_threa
 
 def test_a_callback_does_not_run_once_an_end_was_asked_for_and_a_publish_to_a_closed_topic_ends_it_quietly():
     import faulthandler
+
     import rospy
+
     from tb3_common.ros.lifecycle import Life
     life, calls = Life(), []
 

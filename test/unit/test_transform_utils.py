@@ -44,6 +44,7 @@ def test_normalize_angle_leaves_angles_in_range_unchanged(angle):
 
 
 def test_top_level_transform_utils_serves_the_same_functions():
-    from transform_utils import normalize_angle as top_normalize, quat_to_angle as top_quat
+    from transform_utils import normalize_angle as top_normalize
+    from transform_utils import quat_to_angle as top_quat
     assert top_quat is rbx1_transform_utils.quat_to_angle
     assert top_normalize is rbx1_transform_utils.normalize_angle

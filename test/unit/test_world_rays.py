@@ -5,10 +5,9 @@ import math
 
 import numpy as np
 import pytest
+from test_sensors import FRONT, RIGHT, ROOM, SCAN_X, STEP, pillar
 
 from tb3_sim_nav.bodies import int32
-
-from test_sensors import FRONT, RIGHT, ROOM, SCAN_X, STEP, pillar
 
 GRAZE_AGREE = 0.007  # m: pybullet's ray cast against the exact surfaces, where its convex cast stops short
 
@@ -69,6 +68,7 @@ def test_the_worlds_rays_meet_what_pybullets_meet(world_factory, worlds_folder, 
 
 def test_rays_in_a_world_of_shapes_and_robots_are_not_cast_by_pybullet(world_factory, burger_urdf, monkeypatch):
     import pybullet
+
     from tb3_sim_nav.frames import planar
     from tb3_sim_nav.robot_model import load_model
     robot = world_factory(STEP, 0.5, obstacles=ROOM)

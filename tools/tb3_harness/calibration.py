@@ -19,6 +19,8 @@ import math
 import subprocess
 import time
 
+from tb3_common.pose2d import normalize_angle
+
 from . import report
 from .processes import Process, RunError, say, tail
 from .tutorial import LAUNCH, Recorder, sim_now, wait_for_sim, watch
@@ -41,7 +43,7 @@ def measure(path, start, end):
     if len(samples) < 2:
         raise RunError('fewer than 2 samples between sim time %.2f and %.2f s' % (start, end))
     first, last = samples[0], samples[-1]
-    turned = sum(report.normalize(after[3] - before[3]) for before, after in zip(samples, samples[1:]))
+    turned = sum(normalize_angle(after[3] - before[3]) for before, after in zip(samples, samples[1:]))
     return math.hypot(last[1] - first[1], last[2] - first[2]), turned
 
 

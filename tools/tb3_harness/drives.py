@@ -23,11 +23,17 @@ from tb3_sim_nav.robot_model import load_model
 from tb3_sim_nav.simulation import build
 from tb3_sim_nav.world_file import load_world
 
-from .waypoints import (HOUSE_TOUR, HOUSE_TOUR_START, WORLD_GOALS, WORLD_GOALS_ROUTE, WORLD_LOOP,  # noqa: F401
-                                   WORLD_LOOP_START, Route,
-                                   path_length)  # (for the tests)
-
 from . import ROOT as REPO
+from .waypoints import (  # noqa: F401
+    HOUSE_TOUR,
+    HOUSE_TOUR_START,
+    WORLD_GOALS,
+    WORLD_GOALS_ROUTE,
+    WORLD_LOOP,
+    WORLD_LOOP_START,
+    Route,
+    path_length,  # (for the tests)
+)
 
 #: base_scan in base_footprint on the Burger (x, y, yaw): (-0.032, 0, 0.182) in 3-D.
 BURGER_SCAN_POSE = (-0.032, 0.0, 0.0)

@@ -15,12 +15,12 @@ import math
 
 import numpy as np
 
+from tb3_common.pose2d import compose
 from tb3_navigation.costmap import Costmap
-from tb3_navigation.frontiers import known_window
 from tb3_navigation.exploration import ABORTED, DONE, SEND, SUCCEEDED, WAIT, Explorer
+from tb3_navigation.frontiers import known_window
 from tb3_navigation.occupancy import OccupancyGrid
 from tb3_navigation.planner import GlobalPlanner
-from tb3_common.pose2d import compose
 
 from .nav_sim import SCAN_POSE, Lidar
 

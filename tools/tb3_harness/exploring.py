@@ -85,6 +85,7 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
     through bash); `when_saved()` is called once the map is saved, before anything is stopped."""
     import rosgraph
     import rospkg
+
     from tb3_common.map_files import load_map
     from tb3_sim_nav import world_map
     from tb3_sim_nav.world_file import load_world
@@ -174,7 +175,9 @@ def table(run):
 def draw(run, filename, navigation_path=None):
     """The saved map under the world's outline, with the true path (and a navigation's after it)."""
     import rospkg
+
     from tb3_sim_nav.world_file import load_world
+
     from .map_quality import render_png
     worlds = os.path.join(rospkg.RosPack().get_path('tb3_sim_nav'), 'worlds')
     paths = {'exploration path': [p[1:3] for p in run.truth]}
@@ -189,6 +192,7 @@ def main(argv=None):
     """python3 -m tb3_harness.exploring WORLD --out DIR: one exploration against a master of
     its own (profile realistic, as fast as possible), its figures, and DIR/exploration.png."""
     import argparse
+
     from .processes import start_master
     parser = argparse.ArgumentParser(description=main.__doc__.split('\n')[0])
     parser.add_argument('world', choices=sorted(WORLDS))

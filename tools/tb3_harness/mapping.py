@@ -51,6 +51,7 @@ def _error(estimate, truth):
 
 def _node_pid(name):
     import xmlrpc.client
+
     import rosgraph
     uri = rosgraph.Master('/tb3_harness').lookupNode(name)
     return xmlrpc.client.ServerProxy(uri).getPid('/tb3_harness')[2]
@@ -61,6 +62,7 @@ def map_world(log_dir, output, factor=0.0, profile='realistic', seed=7, world='t
     """One mapping run (see the module's doc); its MappingRun. RunError if a step fails."""
     import rosgraph
     import rospkg
+
     from tb3_common.map_files import load_map
     from tb3_sim_nav.world_file import load_world
     master_uri = os.environ['ROS_MASTER_URI']
@@ -133,7 +135,9 @@ def table(run):
 def draw(run, filename):
     """The saved map under the world's outline, with the true, odometry and map paths."""
     import rospkg
+
     from tb3_sim_nav.world_file import load_world
+
     from .map_quality import render_png
     worlds = os.path.join(rospkg.RosPack().get_path('tb3_sim_nav'), 'worlds')
     render_png(filename, run.grid, run.values, load_world('turtlebot3_world', worlds).obstacles,

@@ -1,4 +1,5 @@
-"""Measurements of running processes, off /proc and the node's own XML-RPC API: for the bench, the soak and the tests."""
+"""Measurements of running processes, off /proc and the node's own XML-RPC API: for the bench, the soak and the
+tests."""
 import os
 import platform
 import xmlrpc.client

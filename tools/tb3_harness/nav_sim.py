@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 
-from tb3_navigation.costmap import Costmap, CostmapConfig
 from tb3_common.pose2d import compose, inverse
+from tb3_navigation.costmap import Costmap, CostmapConfig
 from tb3_navigation.scan import Scan
 from tb3_sim_nav import world_map
 from tb3_sim_nav.world_file import load_world

@@ -177,6 +177,7 @@ def clearance(path, obstacles, footprint):
 def closest(path, obstacles, footprint):
     """(clearance, the path's sample where the footprint came closest)."""
     import numpy as np
+
     from tb3_navigation.costmap import outline as footprint_outline
     from tb3_sim_nav.world_map import in_plane, signed_distance
     outline = footprint_outline(footprint, 0.01)
@@ -232,8 +233,10 @@ def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD
     import rosgraph
     import rospkg
     import rospy
+
     from tb3_common.map_files import load_map
     from tb3_sim_nav.world_file import load_world
+
     from .mapping import _node_pid
     from .measure import cpu_seconds
     from .processes import Process, wait_until
@@ -302,7 +305,9 @@ def table(run):
 def draw(run, filename):
     """The map with the world's outline, the true path, the plans and a few particle clouds."""
     import rospkg
+
     from tb3_sim_nav.world_file import load_world
+
     from .map_quality import render_png
     package = rospkg.RosPack().get_path('tb3_sim_nav')
     paths = {'true path': [p[1:3] for p in run.truth]}

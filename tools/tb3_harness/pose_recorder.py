@@ -24,10 +24,11 @@ def main(argv=None):
     args = parser.parse_args(argv)
 
     import rospy
-    from tb3_common.ros.poses import plane_pose
     import tf2_ros
     from nav_msgs.msg import Odometry
+
     from tb3_common.ros import lifecycle
+    from tb3_common.ros.poses import plane_pose
 
     life = lifecycle.init_node('pose_recorder', anonymous=True)
     buffer = tf2_ros.Buffer()

@@ -10,7 +10,7 @@ across runs of a test (`map_figures`: those of a map that a bound judges).
 import math
 from collections import namedtuple
 
-from tb3_common.pose2d import normalize_angle as normalize, yaw_of_quaternion as yaw_of  # noqa: F401 (for callers)
+from tb3_common.pose2d import normalize_angle
 
 RunResult = namedtuple('RunResult', 'script truth odom wall_time sim_time exit_code error')
 RunResult.__doc__ = """One script's run.
@@ -38,15 +38,15 @@ def summarize(run):
     travelled = turned = 0.0
     for before, after in zip(run.truth, run.truth[1:]):
         travelled += math.hypot(after[1] - before[1], after[2] - before[2])
-        turned += abs(normalize(after[3] - before[3]))
+        turned += abs(normalize_angle(after[3] - before[3]))
     odom_end = drift_distance = drift_heading = None
     if run.odom:
         odom_end = run.odom[-1]
         truth_then = nearest(run.truth, odom_end[0])
         drift_distance = math.hypot(odom_end[1] - truth_then[1], odom_end[2] - truth_then[2])
-        drift_heading = normalize(odom_end[3] - truth_then[3])
+        drift_heading = normalize_angle(odom_end[3] - truth_then[3])
     return Summary(start, end, odom_end,
-                   math.hypot(end[1] - start[1], end[2] - start[2]), normalize(end[3] - start[3]),
+                   math.hypot(end[1] - start[1], end[2] - start[2]), normalize_angle(end[3] - start[3]),
                    drift_distance, drift_heading, travelled, turned)
 
 

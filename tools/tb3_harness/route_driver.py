@@ -28,11 +28,12 @@ def main(argv=None):
     args = parser.parse_args(argv)
 
     import rospy
-    from tb3_common.ros.poses import plane_pose
     import tf2_ros
     from geometry_msgs.msg import Twist
     from nav_msgs.msg import Odometry
+
     from tb3_common.ros import lifecycle
+    from tb3_common.ros.poses import plane_pose
 
     from . import waypoints
     route = waypoints.Route(getattr(waypoints, ROUTES[args.route]))

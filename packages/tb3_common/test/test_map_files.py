@@ -11,9 +11,8 @@ from PIL import Image
 
 from tb3_common import map_files, pose2d
 from tb3_common.grid import Grid
-from tb3_common.pose2d import quaternion_of_yaw
 from tb3_common.map_files import MapFileError, SaverConfig
-
+from tb3_common.pose2d import quaternion_of_yaw
 from tb3_harness import ROOT as REPO
 
 FIXTURE = REPO / 'test' / 'data' / 'map_saver'
@@ -344,8 +343,9 @@ def test_map_saver_refuses_bad_use_with_its_messages_and_statuses(argv, status, 
 def test_map_messages_carry_the_grid_and_its_values_both_ways():
     from io import BytesIO
 
-    from nav_msgs.msg import OccupancyGrid
     import rospy
+    from nav_msgs.msg import OccupancyGrid
+
     from tb3_common.ros.map_messages import grid_of_message, occupancy_grid
     grid = Grid(0.05, 4, 3, (-1.0, 2.0, 0.5))
     values = np.arange(12, dtype=np.int8).reshape(3, 4) - 1

@@ -5,8 +5,18 @@ from typing import Optional
 
 import pytest
 
-from tb3_common.params import (Checked, ParameterError, fail, frame_id, non_negative, number, one_of, parameter,
-                               points, positive)
+from tb3_common.params import (
+    Checked,
+    ParameterError,
+    fail,
+    frame_id,
+    non_negative,
+    number,
+    one_of,
+    parameter,
+    points,
+    positive,
+)
 
 
 @dataclasses.dataclass(frozen=True)

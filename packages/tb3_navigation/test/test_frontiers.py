@@ -8,23 +8,34 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from tb3_navigation.costmap import Costmap, CostmapConfig
-from tb3_navigation.exploration import ABORTED, DONE, KEEP, SEND, SUCCEEDED, WAIT, Explorer
-from tb3_navigation.frontiers import (BLACKLISTED, CANDIDATE, IN_THE_OPEN, NO_ROOM, OUTSIDE, TOO_SMALL, UNREACHABLE,
-                                      ExploreConfig, FrontierSearch, explored_area, frontier_cells, label_frontiers)
 from tb3_common.grid import Grid
-from tb3_navigation.occupancy import OccupancyGrid
-from tb3_navigation.planner import GlobalPlanner, plan_length
 from tb3_common.pose2d import compose
-from tb3_navigation.scan import Scan
-from tb3_harness.map_quality import measure
-from tb3_sim_nav import world_map
-from tb3_sim_nav.world_file import load_world
-
 from tb3_harness import ROOT as REPO
 from tb3_harness.drives import HOUSE_TOUR, HOUSE_TOUR_START, record_drive
 from tb3_harness.explore_sim import ExploreLoop
+from tb3_harness.map_quality import measure
 from tb3_harness.nav_sim import world_cut
+from tb3_navigation.costmap import Costmap, CostmapConfig
+from tb3_navigation.exploration import ABORTED, DONE, KEEP, SEND, SUCCEEDED, WAIT, Explorer
+from tb3_navigation.frontiers import (
+    BLACKLISTED,
+    CANDIDATE,
+    IN_THE_OPEN,
+    NO_ROOM,
+    OUTSIDE,
+    TOO_SMALL,
+    UNREACHABLE,
+    ExploreConfig,
+    FrontierSearch,
+    explored_area,
+    frontier_cells,
+    label_frontiers,
+)
+from tb3_navigation.occupancy import OccupancyGrid
+from tb3_navigation.planner import GlobalPlanner, plan_length
+from tb3_navigation.scan import Scan
+from tb3_sim_nav import world_map
+from tb3_sim_nav.world_file import load_world
 
 RESOLUTION = 0.05
 SYMBOLS = {'.': 0, '#': 100, '?': -1, 'R': 0}

@@ -61,7 +61,8 @@ def test_a_map_without_obstacles_is_max_dist_everywhere():
 def test_flat_occupancy_grid_data_is_accepted_and_a_wrong_size_is_not():
     grid = Grid(0.1, 6, 4)
     values = random_map(4, grid)
-    assert np.array_equal(LikelihoodField(grid, values.ravel().tolist()).distance, LikelihoodField(grid, values).distance)
+    flat = LikelihoodField(grid, values.ravel().tolist())
+    assert np.array_equal(flat.distance, LikelihoodField(grid, values).distance)
     with pytest.raises(ValueError, match='24 values'):
         LikelihoodField(grid, np.zeros(23))
     with pytest.raises(ValueError, match='laser_likelihood_max_dist'):

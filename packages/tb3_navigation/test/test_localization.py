@@ -11,17 +11,14 @@ import math
 import numpy as np
 import pytest
 
+from tb3_common.map_files import load_map
+from tb3_common.pose2d import compose, inverse, normalize_angle
 from tb3_harness import ROOT as REPO
 from tb3_harness.drives import TIGHT, WORLD_LOOP, WORLD_LOOP_START, record_drive, run, scan, travelled, world_grid
-from tb3_navigation.amcl_config import AmclConfig
-from tb3_common.grid import Grid
-from tb3_common.map_files import load_map
 from tb3_navigation import localization
+from tb3_navigation.amcl_config import AmclConfig
 from tb3_navigation.localization import RVIZ_COVARIANCE, Amcl, covariance_3x3, covariance_6x6
-from tb3_common.pose2d import compose, inverse, normalize_angle
 from tb3_navigation.scan import Scan, endpoints
-from tb3_sim_nav import world_map
-from tb3_sim_nav.world_file import load_world
 
 #: Through the house's west room, the corridor and the east room from tb3_house.launch's spawn pose.
 HOUSE_START = (-3.0, 1.0, 0.0)
@@ -109,7 +106,8 @@ def test_an_initial_pose_spreads_max_particles_as_its_gaussian(world):
     assert np.allclose(poses[:, :2].mean(axis=0), (-2.0, -0.5), atol=3 * 0.5 / math.sqrt(3000))
     assert np.allclose(poses[:, :2].std(axis=0), 0.5, rtol=0.05)
     turn = normalize_angle(poses[:, 2] - 3.0)  # wrapped at +-pi, yet centred on 3.0
-    assert abs(turn.mean()) < 3 * (math.pi / 12) / math.sqrt(3000) and turn.std() == pytest.approx(math.pi / 12, rel=0.05)
+    assert abs(turn.mean()) < 3 * (math.pi / 12) / math.sqrt(3000)
+    assert turn.std() == pytest.approx(math.pi / 12, rel=0.05)
     with pytest.raises(ValueError, match='positive semi-definite'):
         amcl.initialise((0, 0, 0), np.diag([0.25, -0.25, 0.1]))
     with pytest.raises(ValueError, match='finite'):
@@ -153,7 +151,8 @@ def test_a_nomotion_update_refines_a_robot_standing_still(world, loop):
         assert amcl.update(loop.odom[0], reading, loop.scan_pose)
     assert not amcl.update(loop.odom[0], reading, loop.scan_pose)  # a request is good for one update
     last = amcl.estimate()
-    error = lambda estimate: math.hypot(estimate.pose[0] - start[0], estimate.pose[1] - start[1])
+    def error(estimate):
+        return math.hypot(estimate.pose[0] - start[0], estimate.pose[1] - start[1])
     assert error(first) > 0.15 and error(last) < min(0.08, error(first) / 2.5)
     assert np.trace(last.covariance[:2, :2]) < 0.1 * np.trace(first.covariance[:2, :2])
     assert len(amcl.particles) < 1000  # KLD let the particles go as the cloud shrank

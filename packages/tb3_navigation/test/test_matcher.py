@@ -4,9 +4,9 @@ import math
 import numpy as np
 import pytest
 
+from tb3_common.pose2d import compose
 from tb3_navigation import matcher
 from tb3_navigation.occupancy import OccupancyGrid
-from tb3_common.pose2d import compose
 from tb3_navigation.scan import Scan
 from tb3_sim_nav import world_map
 from tb3_sim_nav.world_file import Obstacle

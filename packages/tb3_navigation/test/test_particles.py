@@ -4,8 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from tb3_navigation import particles as pf
 from tb3_common.pose2d import compose, normalize_angle, relative
+from tb3_navigation import particles as pf
 
 
 def cloud(rng, count, mean, std):

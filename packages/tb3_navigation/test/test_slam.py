@@ -10,13 +10,12 @@ import pytest
 
 from tb3_common.params import ParameterError
 from tb3_common.pose2d import IDENTITY, compose, normalize_angle, relative
-from tb3_navigation.scan import Scan
-from tb3_navigation.slam import Slam, SlamConfig
-from tb3_harness.map_quality import measure
-from tb3_sim_nav.world_file import load_world
-
 from tb3_harness import ROOT as REPO
 from tb3_harness.drives import HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, path_length, record_drive
+from tb3_harness.map_quality import measure
+from tb3_navigation.scan import Scan
+from tb3_navigation.slam import Slam, SlamConfig
+from tb3_sim_nav.world_file import load_world
 
 #: turtlebot3_slam's gmapping_params.yaml (ROBOTIS-GIT/turtlebot3, noetic), the values we share.
 TURTLEBOT3_GMAPPING = dict(map_update_interval=2.0, maxUrange=3.0, sigma=0.05, lstep=0.05, astep=0.05,

@@ -5,8 +5,17 @@ import math
 import pytest
 
 from tb3_common.params import ParameterError
-from turtlebot3_gazebo.drive import (ANGULAR_VELOCITY, GET_TB3_DIRECTION, LINEAR_VELOCITY, TB3_DRIVE_FORWARD,
-                                     TB3_LEFT_TURN, TB3_RIGHT_TURN, Drive, DriveConfig, beam_index)
+from turtlebot3_gazebo.drive import (
+    ANGULAR_VELOCITY,
+    GET_TB3_DIRECTION,
+    LINEAR_VELOCITY,
+    TB3_DRIVE_FORWARD,
+    TB3_LEFT_TURN,
+    TB3_RIGHT_TURN,
+    Drive,
+    DriveConfig,
+    beam_index,
+)
 
 RANGE_MAX = 3.5
 FULL_CIRCLE = 2.0 * math.pi / 360  # LDS-01: 360 beams from 0

@@ -17,11 +17,24 @@ import math
 
 import rospy
 from gazebo_msgs.msg import LinkStates, ModelState, ModelStates, ODEPhysics
-from gazebo_msgs.srv import (DeleteModel, DeleteModelResponse, GetModelProperties, GetModelPropertiesResponse,
-                             GetModelState, GetModelStateResponse, GetPhysicsProperties,
-                             GetPhysicsPropertiesResponse, GetWorldProperties, GetWorldPropertiesResponse,
-                             SetModelState, SetModelStateResponse, SetPhysicsProperties,
-                             SetPhysicsPropertiesResponse, SpawnModel, SpawnModelResponse)
+from gazebo_msgs.srv import (
+    DeleteModel,
+    DeleteModelResponse,
+    GetModelProperties,
+    GetModelPropertiesResponse,
+    GetModelState,
+    GetModelStateResponse,
+    GetPhysicsProperties,
+    GetPhysicsPropertiesResponse,
+    GetWorldProperties,
+    GetWorldPropertiesResponse,
+    SetModelState,
+    SetModelStateResponse,
+    SetPhysicsProperties,
+    SetPhysicsPropertiesResponse,
+    SpawnModel,
+    SpawnModelResponse,
+)
 from geometry_msgs.msg import Pose, Twist
 
 from ..frames import compose, normalized

@@ -8,7 +8,6 @@ import queue
 import threading
 import time
 
-import rospy
 from visualization_msgs.msg import MarkerArray
 
 from ..simulation import ModelStateError

@@ -14,8 +14,9 @@ import rospkg
 import rospy
 from rosgraph_msgs.msg import Clock
 from std_srvs.srv import Empty, EmptyResponse
-from tb3_common.ros import lifecycle
 from tf2_msgs.msg import TFMessage
+
+from tb3_common.ros import lifecycle
 
 from .. import params
 from ..frames import planar
@@ -205,7 +206,8 @@ def _start_up():
                           len(world.obstacles), config.map_wall_height)
         if 'TURTLEBOT3_MODEL' not in os.environ:
             rospy.loginfo('tb3_sim: TURTLEBOT3_MODEL is not set: the launch gave model %s (burger unless model:= '
-                          'says otherwise; export TURTLEBOT3_MODEL=burger, waffle or waffle_pi to choose)', config.model)
+                          'says otherwise; export TURTLEBOT3_MODEL=burger, waffle or waffle_pi to choose)',
+                          config.model)
         return config, build(config, world.obstacles, robots)
     except (params.ParameterError, ModelError, WorldError, ValueError) as error:
         rospy.logfatal('tb3_sim cannot start: %s', error)

@@ -30,14 +30,14 @@ from nav_msgs.msg import OccupancyGrid
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
-from tb3_navigation.costmap import CostmapConfig
-from tb3_navigation.exploration import DONE, SEND, WAIT, Explorer
-from tb3_navigation.frontiers import BLACKLISTED, CANDIDATE, ExploreConfig, explored_area
 from tb3_common.params import Checked, frame_id, non_negative, parameter
 from tb3_common.pose2d import quaternion_of_yaw
 from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import Frames, namespaced
 from tb3_common.ros.map_messages import grid_of_message
+from tb3_navigation.costmap import CostmapConfig
+from tb3_navigation.exploration import DONE, SEND, WAIT, Explorer
+from tb3_navigation.frontiers import BLACKLISTED, CANDIDATE, ExploreConfig, explored_area
 
 NODE = 'explore'
 SERVER_WARN_PERIOD = 5.0  # wall s between "waiting for move_base" warnings (explore_lite's)

@@ -25,11 +25,11 @@ from nav_msgs.srv import GetMap, GetMapResponse
 from sensor_msgs.msg import LaserScan
 
 from gmapping.config import UNHONOURED, NodeConfig
-from tb3_navigation.scan import Scan
-from tb3_navigation.slam import Slam, SlamConfig
 from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import Frames, namespaced
 from tb3_common.ros.map_messages import occupancy_grid
+from tb3_navigation.scan import Scan
+from tb3_navigation.slam import Slam, SlamConfig
 
 NODE = 'slam_gmapping'  # gmapping's own name for it; a launch file gives another (tb3_slam, turtlebot3_slam_gmapping)
 

@@ -168,5 +168,6 @@ class Checked(object):
 
 def fields_of(config_class):
     """[(name, default, kind, doc, unit)] of a Checked dataclass, for tables and messages."""
-    return [(field.name, field.default, kind_of(field)[0], field.metadata.get('doc', ''), field.metadata.get('unit', ''))
+    return [(field.name, field.default, kind_of(field)[0], field.metadata.get('doc', ''),
+             field.metadata.get('unit', ''))
             for field in dataclasses.fields(config_class)]

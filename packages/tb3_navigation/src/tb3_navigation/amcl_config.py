@@ -20,14 +20,17 @@ class AmclConfig(Checked):
     noetic) and amcl's defaults for those it leaves out."""
     min_particles: int = parameter(500, 'fewest particles KLD-sampling keeps', number(1))
     max_particles: int = parameter(3000, 'most particles (and the count after an initial pose)', number(1))
-    kld_err: float = parameter(0.02, 'largest KL distance of the particles to the truth', number(0.0, 1.0, low_open=True))
+    kld_err: float = parameter(0.02, 'largest KL distance of the particles to the truth',
+                               number(0.0, 1.0, low_open=True))
     kld_z: float = parameter(0.99, 'upper standard normal quantile for (1 - p), as amcl uses it', positive)
     update_min_d: float = parameter(0.20, 'translation (m) before a filter update', non_negative)
     update_min_a: float = parameter(0.20, 'rotation (rad) before a filter update', non_negative)
     resample_interval: int = parameter(1, 'filter updates between two resamplings', number(1))
     transform_tolerance: float = parameter(0.5, 'the node post-dates map -> odom by this (s)', non_negative)
-    recovery_alpha_slow: float = parameter(0.0, 'decay of the slow average weight; 0 = no random particles', number(0.0, 1.0))
-    recovery_alpha_fast: float = parameter(0.0, 'decay of the fast average weight; 0 = no random particles', number(0.0, 1.0))
+    recovery_alpha_slow: float = parameter(0.0, 'decay of the slow average weight; 0 = no random particles',
+                                           number(0.0, 1.0))
+    recovery_alpha_fast: float = parameter(0.0, 'decay of the fast average weight; 0 = no random particles',
+                                           number(0.0, 1.0))
     initial_pose_x: float = parameter(0.0, 'initial pose x (m, map)', None)
     initial_pose_y: float = parameter(0.0, 'initial pose y (m, map)', None)
     initial_pose_a: float = parameter(0.0, 'initial yaw (rad, map)', None)
@@ -45,8 +48,10 @@ class AmclConfig(Checked):
     laser_sigma_hit: float = parameter(0.2, "standard deviation (m) of the model's Gaussian", positive)
     laser_lambda_short: float = parameter(0.1, "decay of short readings (amcl's beam model only)", positive)
     laser_likelihood_max_dist: float = parameter(2.0, 'the distance field is capped here (m)', positive)
-    laser_model_type: str = parameter('likelihood_field', "amcl's beam and likelihood_field_prob: not here", one_of(*LASER_MODELS))
-    odom_model_type: str = parameter('diff', 'the motion model (a Burger is differential: no omni)', one_of(*ODOM_MODELS))
+    laser_model_type: str = parameter('likelihood_field', "amcl's beam and likelihood_field_prob: not here",
+                                      one_of(*LASER_MODELS))
+    odom_model_type: str = parameter('diff', 'the motion model (a Burger is differential: no omni)',
+                                     one_of(*ODOM_MODELS))
     odom_alpha1: float = parameter(0.1, "rotation's noise from rotation", non_negative)
     odom_alpha2: float = parameter(0.1, "rotation's noise from translation", non_negative)
     odom_alpha3: float = parameter(0.1, "translation's noise from translation", non_negative)
@@ -55,7 +60,9 @@ class AmclConfig(Checked):
     base_frame_id: str = parameter('base_footprint', "the robot's frame", frame_id)
     global_frame_id: str = parameter('map', "the map's frame", frame_id)
     tf_broadcast: bool = parameter(True, 'publish map -> odom')
-    refine_estimate: bool = parameter(True, "ours: the estimate matched to the map by the scan (see Amcl); false: amcl's mean")
+    refine_estimate: bool = parameter(True,
+                                      "ours: the estimate matched to the map by the scan (see Amcl); false: amcl's "
+                                      'mean')
 
     def check_together(self):
         if self.max_particles < self.min_particles:

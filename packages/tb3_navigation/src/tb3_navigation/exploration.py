@@ -23,8 +23,8 @@ there and saw all it could: explore_lite would sit there for progress_timeout,
 import math
 from dataclasses import dataclass
 
-from .frontiers import ExploreConfig, FrontierSearch
 from .costmap import CostmapConfig
+from .frontiers import ExploreConfig, FrontierSearch
 from .planner import PlannerConfig
 
 SEND, KEEP, WAIT, DONE = 'send', 'keep', 'wait', 'done'

@@ -61,9 +61,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from .costmap import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE, Costmap, CostmapConfig, inflation_costs
 from tb3_common.grid import Grid
 from tb3_common.params import Checked, non_negative, parameter, positive
+
+from .costmap import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE, Costmap, CostmapConfig, inflation_costs
 from .grid_graph import path_to
 from .planner import GlobalPlanner, PlannerConfig
 

@@ -49,11 +49,11 @@ from collections import namedtuple
 
 import numpy as np
 
+from tb3_common.pose2d import compose, inverse, normalize_angle
 from tb3_navigation import matcher
 from tb3_navigation import particles as pf
 from tb3_navigation.amcl_config import AmclConfig
 from tb3_navigation.likelihood import LikelihoodField, LikelihoodFieldModel
-from tb3_common.pose2d import compose, inverse, normalize_angle
 from tb3_navigation.scan import endpoints
 
 #: rviz's 2D Pose Estimate and amcl's initial_cov_*: 0.5 m and 15 degrees of standard deviation.

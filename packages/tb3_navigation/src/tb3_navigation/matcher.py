@@ -34,7 +34,6 @@ from scipy import ndimage
 
 from tb3_common.pose2d import normalize_angle
 
-
 #: Half the side, in cells, of the square of occupied cells whose mean points give a wall's direction.
 SHAPE_RADIUS = 2
 #: A cell's neighbourhood is taken as a line when its spread across is below this share of its spread along

@@ -22,8 +22,9 @@ import math
 
 import numpy as np
 
-from . import raytrace
 from tb3_common.grid import FREE, OCCUPIED, UNKNOWN, Grid
+
+from . import raytrace
 
 OCC_THRESH = 0.25  # gmapping's occ_thresh
 

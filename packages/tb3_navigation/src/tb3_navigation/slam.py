@@ -42,11 +42,11 @@ import math
 
 import numpy as np
 
-from . import matcher
-from .occupancy import OccupancyGrid
 from tb3_common.params import Checked, fail, non_negative, number, parameter, positive
 from tb3_common.pose2d import IDENTITY, compose, inverse, relative
 
+from . import matcher
+from .occupancy import OccupancyGrid
 
 #: After an odometry jump the prediction is only as good as the odometry's drift since the map last
 #: corrected it (turtlebot3_world's loop: 14 cm and 2.7 degrees after 55 s): search 3 times as far.
