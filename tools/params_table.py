@@ -9,12 +9,18 @@ import sys
 from tb3_sim_nav.params import FROM_MODEL, FROM_PROFILE, PARAMETERS, PROFILES
 
 #: (node, parameter namespace, config class) of the navigation nodes, in doc/reference.md's order.
-NAVIGATION = [('tb3_slam', '', 'tb3_navigation.slam.SlamConfig'),
+NAVIGATION = [('slam_gmapping', '', 'tb3_navigation.slam.SlamConfig'),
+              ('slam_gmapping', '', 'gmapping.config.NodeConfig'),
               ('amcl', '', 'tb3_navigation.amcl_config.AmclConfig'),
+              ('amcl', '', 'amcl.config.AmclNodeConfig'),
+              ('move_base', '', 'move_base.settings.MoveBaseConfig'),
               ('move_base', '', 'tb3_navigation.navigator.NavigatorConfig'),
+              ('move_base', 'global_costmap/, local_costmap/', 'move_base.costmap_params.CostmapROSConfig'),
               ('move_base', 'global_costmap/, local_costmap/', 'tb3_navigation.costmap.CostmapConfig'),
-              ('move_base', 'NavfnROS/', 'tb3_navigation.planner.PlannerConfig'),
-              ('move_base', 'DWAPlannerROS/', 'tb3_navigation.controller.DwaConfig')]
+              ('move_base', 'global_costmap/SOURCE/, local_costmap/SOURCE/', 'move_base.costmap_params.ObservationSource'),
+              ('move_base', 'NavfnROS/, GlobalPlanner/', 'tb3_navigation.planner.PlannerConfig'),
+              ('move_base', 'DWAPlannerROS/', 'tb3_navigation.controller.DwaConfig'),
+              ('move_base', 'TrajectoryPlannerROS/', 'move_base.planners.TrajectoryPlannerConfig')]
 
 
 def shown(value):
