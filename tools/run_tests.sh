@@ -46,11 +46,12 @@ lint() {
 }
 export -f lint
 
-# ruff (tools/ruff.toml) on every python file of ours: the .py files, and the scripts without the suffix.
+# ruff (tools/ruff.toml) on every python file of ours: the .py files, the scripts without the suffix and the
+# dynamic_reconfigure .cfg files.
 ruff_lint() {
   local scripts
-  scripts=$(for file in $(find scripts packages/*/scripts packages/*/nodes -type f ! -name '*.py' 2>/dev/null); do
-    head -c 64 "$file" | grep -q python && echo "$file"; done)
+  scripts=$(for file in $(find scripts packages/*/scripts packages/*/nodes cfg packages/*/cfg -type f ! -name '*.py' \
+    2>/dev/null); do head -c 64 "$file" | grep -q python && echo "$file"; done)
   ruff check --config tools/ruff.toml . $scripts
 }
 export -f ruff_lint

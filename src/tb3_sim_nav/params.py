@@ -11,6 +11,7 @@ limits default to the robot model's own (its URDF's <drive_limits>).
 import dataclasses
 from typing import Optional
 
+from tb3_common.cfg import live_fields
 from tb3_common.params import (
     ParameterError,
     checked,
@@ -190,7 +191,7 @@ class Config(object):
 PARAMETERS = dataclasses.fields(Config)
 _BY_NAME = dict((field.name, field) for field in PARAMETERS)
 #: Those that may change while the simulator runs.
-LIVE = [field for field in PARAMETERS if field.metadata['live']]
+LIVE = live_fields(Config)
 
 
 def check(name, value):

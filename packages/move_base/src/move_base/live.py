@@ -16,11 +16,10 @@ logged; a bad one is refused with the reason, logged, and nothing changes
 (dynparam get then shows the old value). No bounds in the .cfg files:
 dynamic_reconfigure would clamp an out-of-range value without a word.
 """
-import dataclasses
-
 import rospy
 from dynamic_reconfigure.server import Server
 
+from tb3_common.cfg import live_fields
 from tb3_common.params import ParameterError
 
 from .settings import qualified, trajectory_dwa
@@ -28,7 +27,7 @@ from .settings import qualified, trajectory_dwa
 
 def live_names(config_class):
     """The names of a config's live fields (parameter(..., live=True))."""
-    return [field.name for field in dataclasses.fields(config_class) if field.metadata.get('live')]
+    return [field.name for field in live_fields(config_class)]
 
 
 class Live(object):
