@@ -25,17 +25,17 @@ import threading
 import numpy as np
 import rospy
 from dynamic_reconfigure.server import Server
-from geometry_msgs.msg import Pose, PoseArray, PoseWithCovarianceStamped
+from geometry_msgs.msg import PoseArray, PoseWithCovarianceStamped
 from nav_msgs.msg import OccupancyGrid
 from nav_msgs.srv import GetMap, SetMap, SetMapResponse
 from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty, EmptyResponse
 
 from tb3_common.params import ParameterError
-from tb3_common.pose2d import quaternion_of_yaw, yaw_of_quaternion
 from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import Frames, namespaced
 from tb3_common.ros.map_messages import grid_of_message
+from tb3_common.ros.poses import plane_pose, pose_message
 from tb3_navigation.amcl_config import AmclConfig
 from tb3_navigation.localization import Amcl, covariance_3x3, covariance_6x6
 from tb3_navigation.scan import Scan
@@ -44,14 +44,6 @@ from .config import AmclNodeConfig, amcl_values, changed, live_fields, node_valu
 
 NODE = 'amcl'
 FRAMES = {'odom_frame_id': 'odom', 'base_frame_id': 'base_footprint', 'global_frame_id': 'map'}
-
-
-def _pose_message(pose):
-    message = Pose()
-    message.position.x, message.position.y = pose[0], pose[1]
-    (message.orientation.x, message.orientation.y, message.orientation.z,
-     message.orientation.w) = quaternion_of_yaw(pose[2])
-    return message
 
 
 class AmclNode(object):
@@ -145,9 +137,7 @@ class AmclNode(object):
 
     # --- requests -----------------------------------------------------------------------
     def _on_initial_pose(self, message):
-        pose = message.pose.pose
-        yaw = yaw_of_quaternion(pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w)
-        values = (pose.position.x, pose.position.y, yaw)
+        values = plane_pose(message)
         frame = message.header.frame_id.lstrip('/')
         if frame != self.config.global_frame_id:
             rospy.logwarn('%s: ignoring an initial pose in frame "%s": initial poses must be in the global frame, '
@@ -187,10 +177,8 @@ class AmclNode(object):
         return EmptyResponse()
 
     def _on_set_map(self, request):
-        pose = request.initial_pose.pose.pose
-        self._on_map(request.map, (pose.position.x, pose.position.y, yaw_of_quaternion(
-            pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w)),
-            covariance_3x3(request.initial_pose.pose.covariance))
+        initial = request.initial_pose
+        self._on_map(request.map, plane_pose(initial), covariance_3x3(initial.pose.covariance))
         return SetMapResponse(success=True)
 
     # --- scans -------------------------------------------------------------------------------
@@ -229,7 +217,7 @@ class AmclNode(object):
     def _publish_pose(self, estimate, stamp):
         message = PoseWithCovarianceStamped()
         message.header.frame_id, message.header.stamp = self.config.global_frame_id, stamp
-        message.pose.pose = _pose_message(estimate.pose)
+        message.pose.pose = pose_message(estimate.pose)
         message.pose.covariance = covariance_6x6(estimate.covariance)
         self.pose_pub.publish(message)
 
@@ -240,7 +228,7 @@ class AmclNode(object):
         self._last_cloud = stamp
         message = PoseArray()
         message.header.frame_id, message.header.stamp = self.config.global_frame_id, stamp
-        message.poses = [_pose_message(pose) for pose in particles]
+        message.poses = [pose_message(pose) for pose in particles]
         self.cloud_pub.publish(message)
 
     def _save_pose(self, estimate, stamp):

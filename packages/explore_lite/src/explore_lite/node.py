@@ -31,10 +31,10 @@ from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
 from tb3_common.params import Checked, frame_id, non_negative, parameter
-from tb3_common.pose2d import quaternion_of_yaw
 from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import Frames, namespaced
 from tb3_common.ros.map_messages import grid_of_message
+from tb3_common.ros.poses import fill_pose
 from tb3_navigation.costmap import CostmapConfig
 from tb3_navigation.exploration import DONE, SEND, WAIT, Explorer
 from tb3_navigation.frontiers import BLACKLISTED, CANDIDATE, ExploreConfig, explored_area
@@ -167,10 +167,8 @@ class ExploreNode(object):
     def send(self, decision, frame, now, grid, values):
         goal = MoveBaseGoal()
         goal.target_pose.header.frame_id, goal.target_pose.header.stamp = frame, rospy.Time.now()
-        x, y, yaw = decision.goal
-        goal.target_pose.pose.position.x, goal.target_pose.pose.position.y = x, y
-        q = goal.target_pose.pose.orientation
-        q.x, q.y, q.z, q.w = quaternion_of_yaw(yaw)
+        x, y, _ = decision.goal
+        fill_pose(goal.target_pose.pose, decision.goal)
         self._handle = self.client.send_goal(goal, transition_cb=self._on_transition(decision.goal))
         frontier = decision.frontier
         free, occupied, known = explored_area(grid, values)

@@ -36,11 +36,11 @@ from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty, EmptyResponse
 
 from tb3_common.params import ParameterError
-from tb3_common.pose2d import compose, inverse, quaternion_of_yaw, yaw_of_quaternion
+from tb3_common.pose2d import compose, inverse, yaw_of_quaternion
 from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import Frames
 from tb3_common.ros.map_messages import grid_of_message
-from tb3_common.ros.poses import plane_pose
+from tb3_common.ros.poses import plane_pose, pose_stamped
 from tb3_navigation.controller import DwaController
 from tb3_navigation.navigator import ABORTED, PREEMPTED, SUCCEEDED, Navigator
 from tb3_navigation.planner import GlobalPlanner
@@ -53,19 +53,10 @@ from .costmap_io import CostmapIO
 NODE = 'move_base'
 
 
-def _pose_stamped(pose, frame, stamp):
-    message = PoseStamped()
-    message.header.frame_id, message.header.stamp = frame, stamp
-    message.pose.position.x, message.pose.position.y = pose[0], pose[1]
-    (message.pose.orientation.x, message.pose.orientation.y, message.pose.orientation.z,
-     message.pose.orientation.w) = quaternion_of_yaw(pose[2])
-    return message
-
-
 def _path(poses, frame, stamp):
     path = Path()
     path.header.frame_id, path.header.stamp = frame, stamp
-    path.poses = [_pose_stamped(pose, frame, stamp) for pose in poses]
+    path.poses = [pose_stamped(pose, frame, stamp) for pose in poses]
     return path
 
 
@@ -182,7 +173,7 @@ class MoveBaseNode(object):
         if self.navigator.active:
             rospy.loginfo('%s: new goal (%.2f, %.2f, %.2f) in %s', NODE,
                           *(self.navigator.goal + (self.global_io.frame,)))
-            self.goal_pub.publish(_pose_stamped(self.navigator.goal, self.global_io.frame, rospy.Time.now()))
+            self.goal_pub.publish(pose_stamped(self.navigator.goal, self.global_io.frame, rospy.Time.now()))
 
     def _on_preempt(self):
         """A cancel, or a new goal about to replace this one (accept_new_goal then preempts it)."""
@@ -310,7 +301,7 @@ class MoveBaseNode(object):
             elif outcome.status == PREEMPTED:
                 self.server.set_preempted(MoveBaseResult(), outcome.text)
         elif active and pose is not None and self.server.is_active():
-            self.server.publish_feedback(MoveBaseFeedback(base_position=_pose_stamped(pose, self.global_io.frame,
+            self.server.publish_feedback(MoveBaseFeedback(base_position=pose_stamped(pose, self.global_io.frame,
                                                                                     stamp)))
 
     def run(self, life):

@@ -19,8 +19,8 @@ from geometry_msgs.msg import TransformStamped, Twist
 from nav_msgs.msg import Odometry
 from sensor_msgs.msg import JointState
 
-from tb3_common.pose2d import quaternion_of_yaw
 from tb3_common.ros import lifecycle, params
+from tb3_common.ros.poses import fill_pose
 
 from .fake import COVARIANCE, LEFT, RIGHT, WHEEL_SEPARATION, FakeConfig, FakeRobot
 
@@ -67,10 +67,7 @@ class FakeNode(object):
     def publish(self, stamp):
         """One update at `stamp`: odom, joint_states and tf."""
         self.robot.update(stamp.to_sec())
-        x, y, yaw = self.robot.pose
-        pose = self.odom.pose.pose
-        pose.position.x, pose.position.y = x, y
-        pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = quaternion_of_yaw(yaw)
+        fill_pose(self.odom.pose.pose, self.robot.pose)
         self.odom.twist.twist.linear.x, self.odom.twist.twist.angular.z = self.robot.velocity
         self.odom.header.stamp = stamp
         self.odom_pub.publish(self.odom)
@@ -81,8 +78,7 @@ class FakeNode(object):
         self.joints_pub.publish(self.joints)
 
         self.transform.header.stamp = stamp
-        self.transform.transform.translation.x, self.transform.transform.translation.y = x, y
-        self.transform.transform.rotation = pose.orientation
+        fill_pose(self.transform.transform, self.robot.pose)
         self.broadcaster.sendTransform(self.transform)
 
     def run(self, life):
