@@ -122,7 +122,7 @@ def test_a_move_base_that_aborts_every_goal_makes_exploration_stop(tmp_path):
                                folder))
         stand_in = Process('move_base', ['python3', os.path.join(HERE, 'aborting_move_base.py')], folder)
         started.append(stand_in)
-        explore = Process('explore', ['rosrun', 'tb3_navigation', 'explore'], folder)
+        explore = Process('explore', ['rosrun', 'explore_lite', 'explore'], folder)
         started.append(explore)
         wait_until(lambda: exploring.progress(_read(explore.log))[2] is not None, BAD_CASE_TIMEOUT,
                    'the explore node\'s end', poll=0.5, watch=started)
