@@ -32,6 +32,10 @@ class CostmapIO(object):
         self.name, self.config, self.sources = settings.name, settings.config, settings.sources
         self.frame = namespaced(ros.global_frame, namespace)
         self.base_frame = namespaced(ros.robot_base_frame, namespace)
+        # {topic: frame} of the sources that name their sensor's frame, in the robot's namespace as the
+        # costmap's own frames are: ROBOTIS' sensor_frame base_scan is tb3_0/base_scan for tb3_0's move_base.
+        self.sensor_frames = dict((source.topic, namespaced(source.sensor_frame, namespace))
+                                  for _, source in self.sources if source.sensor_frame)
         self.costmap = None
         if ros.rolling_window and not ros.static_map:
             self.costmap = Costmap.rolling(self.config, ros.width, ros.height, ros.resolution)

@@ -243,8 +243,7 @@ class MoveBaseNode(object):
     def _newest_scans(self):
         """{topic: (number, Scan, the sensor's pose in the base frame)} of the newest scan of each topic
         (a source's sensor_frame, if it names one, else the scan's own frame), each converted once."""
-        frames = dict((source.topic, source.sensor_frame) for io in (self.global_io, self.local_io)
-                      for _, source in io.sources)
+        frames = {**self.global_io.sensor_frames, **self.local_io.sensor_frames}
         for topic, (number, message) in list(self._scans.items()):
             if self._converted.get(topic, (None,))[0] != number:
                 sensor = self._sensor_pose(frames.get(topic) or message.header.frame_id)
