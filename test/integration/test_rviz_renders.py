@@ -202,7 +202,7 @@ class RvizRenders(unittest.TestCase):
         except Exception as error:  # reported by every test, with its cause
             cls.setup_error = '%s: %s' % (type(error).__name__, error)
         finally:
-            cls.rviz_output = cls.rviz.output(20000) if cls.rviz else ''
+            cls.rviz_output = cls.rviz.output(None) if cls.rviz else ''
             for child in (cls.rviz, cls.xvfb):
                 if child is not None:
                     child.stop()

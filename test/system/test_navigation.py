@@ -52,7 +52,7 @@ def navigation(tmp_path_factory):
         rospy.init_node('navigation_test', anonymous=True, disable_signals=True)
         nav = Navigation()
         nav.wait_ready()
-        wait_until(lambda: 'map of' in started[1].output(20000), 60.0, 'the map in amcl and move_base',
+        wait_until(lambda: 'map of' in started[1].output(None), 60.0, 'the map in amcl and move_base',
                    watch=started)
         nav.set_pose(*SPAWN)
         nav.logs = started

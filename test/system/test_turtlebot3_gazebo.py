@@ -219,7 +219,7 @@ def test_fake_turns_cmd_vel_into_odom_and_tf_and_stays_up(master, launches, proc
     after = odom.after(mark + 30, 10.0)
     assert after is not None and fake.running(), fake.describe()
     assert all(math.isfinite(value) for value in poses(odom, [after])[0].values()) and poses(odom)[-1]['speed'] == 0.0
-    assert 'NaN or inf' in fake.output(20000), fake.output()
+    assert 'NaN or inf' in fake.output(None), fake.output()
     image = screenshot(display)
     os.makedirs(SHOTS, exist_ok=True)
     save_png(image, os.path.join(SHOTS, 'turtlebot3_fake.png'))

@@ -135,7 +135,7 @@ def navigation(tmp_path_factory):
         rospy.init_node('wiki_navigation_test', anonymous=True, disable_signals=True)
         nav = Navigation()
         nav.wait_ready()
-        wait_until(lambda: started[1].output(100000).count('map of') >= 2, 60.0, 'the map in amcl and move_base',
+        wait_until(lambda: started[1].output(None).count('map of') >= 2, 60.0, 'the map in amcl and move_base',
                    watch=started)
         nav.set_pose(*SPAWN)
         nav.logs = started
@@ -165,7 +165,7 @@ def dynparam(*arguments):
 
 
 def test_the_parameters_are_read_as_the_originals_read_them(navigation):
-    output = navigation.logs[1].output(200000)
+    output = navigation.logs[1].output(None)
     assert 'base_local_planner/TrajectoryPlannerROS' in output
     # Taken without effect, and said so: amcl's omni-only noise, TrajectoryPlannerROS's escape.
     assert 'parameter ~odom_alpha5 = 0.1 has no effect here' in output
@@ -197,8 +197,8 @@ def test_dynparam_slows_the_next_goal_and_a_bad_value_is_refused(navigation):
     assert rospy.get_param('/move_base/TrajectoryPlannerROS/max_vel_x') == SLOW
     refused = dynparam('set', '/move_base/TrajectoryPlannerROS', 'max_vel_x', '-0.5')
     assert rospy.get_param('/move_base/TrajectoryPlannerROS/max_vel_x') == SLOW, refused.stdout
-    wait_until(lambda: 'refused' in navigation.logs[1].output(200000), 10.0, 'the refusal in the log')
-    assert "parameter ~TrajectoryPlannerROS/max_vel_x = -0.5: must be > 0" in navigation.logs[1].output(200000)
+    wait_until(lambda: 'refused' in navigation.logs[1].output(None), 10.0, 'the refusal in the log')
+    assert "parameter ~TrajectoryPlannerROS/max_vel_x = -0.5: must be > 0" in navigation.logs[1].output(None)
     outcome = navigation.go(*SLOW_GOAL)
     fastest = true_speed(outcome.path)
     least, where = closest(outcome.path, world_obstacles(), BURGER_FOOTPRINT)
@@ -219,5 +219,5 @@ def test_amcl_and_the_inflation_layers_serve_their_live_parameters(navigation):
     assert rospy.get_param('/amcl/laser_model_type') == 'likelihood_field'
     assert dynparam('set', '/move_base/global_costmap/inflation_layer', 'inflation_radius', '0.4').returncode == 0
     assert rospy.get_param('/move_base/global_costmap/inflation_layer/inflation_radius') == 0.4
-    output = ''.join(process.output(200000) for process in navigation.logs)
+    output = ''.join(process.output(None) for process in navigation.logs)
     assert "refused" in output and "~laser_model_type = 'beam'" in output

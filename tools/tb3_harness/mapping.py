@@ -79,7 +79,7 @@ def map_world(log_dir, output, factor=0.0, profile='realistic', seed=7, world='t
         sim = spawn('sim', ['roslaunch', 'tb3_sim_bringup', launch, 'profile:=%s' % profile,
                             'real_time_factor:=%g' % factor])
         slam = spawn('slam', ['roslaunch', 'tb3_sim_bringup', 'tb3_slam.launch', 'open_rviz:=false'])
-        wait_until(lambda: 'tb3_slam parameters' in slam.output(20000), READY_TIMEOUT, 'SLAM node',
+        wait_until(lambda: 'tb3_slam parameters' in slam.output(None), READY_TIMEOUT, 'SLAM node',
                    watch=(sim, slam))
         slam_pid = _node_pid('/tb3_slam')
         path_file = os.path.join(log_dir, 'route_%g.json' % factor)

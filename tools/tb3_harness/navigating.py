@@ -250,7 +250,7 @@ def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD
                                        'real_time_factor:=%g' % factor], log_dir, die_with_parent=True))
         started.append(Process('nav', ['roslaunch', 'tb3_sim_bringup', 'tb3_navigation.launch', 'open_rviz:=false',
                                        'map_file:=%s' % map_file], log_dir, die_with_parent=True))
-        wait_until(lambda: started[1].output(20000).count('map of') >= 2, 60.0, 'the map in amcl and move_base',
+        wait_until(lambda: started[1].output(None).count('map of') >= 2, 60.0, 'the map in amcl and move_base',
                    watch=started)
         navigation = Navigation()
         navigation.wait_ready()
