@@ -19,6 +19,7 @@ must lie on the world's walls, and the goal must SUCCEED with the true pose
 within DWAPlannerROS's tolerances. The screenshots go to
 ~/.ros/test_results/tb3_sim_nav/emanual/ (doc/'s pictures are copies).
 """
+import glob
 import json
 import math
 import os
@@ -63,6 +64,7 @@ def bash(command):
 UNKNOWN = (92, 110, 108)  # rviz's "map" scheme: an unknown cell (-1) on the view's background
 FLOOR = (192, 192, 192)   # a free cell (0)
 WALL = (14, 14, 14)       # an occupied one (100)
+PARTICLES = (0, 192, 0)   # turtlebot3_navigation.rviz's "Amcl Particles" (its LaserScan is (0, 255, 0))
 
 
 def colour_pixels(image, colour, tolerance=25):
@@ -91,6 +93,33 @@ def truth_now():
     pose = yaml.safe_load(echoed[echoed.index('position:'):].split('---')[0])
     q = pose['orientation']
     return pose['position']['x'], pose['position']['y'], yaw_of_quaternion(q['x'], q['y'], q['z'], q['w'])
+
+
+def echoed(output):
+    """The first message `rostopic echo` printed (it may warn first: "Is /clock being published?")."""
+    return yaml.safe_load(output[output.index('header:'):].split('---')[0])
+
+
+def rviz_topics(config, kind):
+    """The topics of the enabled displays of class `kind` in an rviz config, those in groups too."""
+    with open(config) as stream:
+        displays = list(yaml.safe_load(stream)['Visualization Manager']['Displays'])
+    topics = []
+    while displays:
+        display = displays.pop(0)
+        displays.extend(display.get('Displays', []))
+        if display.get('Class') == kind and display.get('Enabled'):
+            topics.append(display['Topic'])
+    return topics
+
+
+def node_log(home, node):
+    """What `node` wrote to its log file in the run's log folder (ROS_HOME/log/latest)."""
+    text = ''
+    for path in glob.glob(os.path.join(home, '.ros', 'log', 'latest', node + '-*.log')):
+        with open(path, errors='replace') as stream:
+            text += stream.read()
+    return text
 
 
 def check_map(yaml_file):
@@ -160,37 +189,38 @@ def test_map_save_and_navigate_as_the_emanual_does(ros_port, processes, desktop)
 
     nav = processes.start('navigation', bash('roslaunch turtlebot3_navigation turtlebot3_navigation.launch '
                                              'map_file:=$HOME/map.yaml'))
-    assert wait_until(lambda: nav.output(None).count('map of') >= 2, TIMEOUT), nav.describe()
+    # The map in move_base (its lines on the screen) and in amcl (ROBOTIS' amcl.launch sends them to its log).
+    assert wait_until(lambda: 'map of' in nav.output(None) and 'map of' in node_log(home, 'amcl'), TIMEOUT), \
+        (nav.describe(), node_log(home, 'amcl')[-3000:])
     assert run(bash(INITIAL_POSE), TIMEOUT).returncode == 0
+    # What rviz draws while navigating: the plans it subscribes to (the Path displays of ROBOTIS' view),
+    # each as move_base sends it, and on the screen amcl's particles and the costmaps.
+    paths = rviz_topics(os.path.join(rospkg.RosPack().get_path('turtlebot3_navigation'), 'rviz',
+                                     'turtlebot3_navigation.rviz'), 'rviz/Path')
+    assert {'/move_base/NavfnROS/plan', '/move_base/DWAPlannerROS/global_plan'} <= set(paths), paths
+    plans = [processes.start('plan_%d' % number, ['rostopic', 'echo', '-n', '1', topic])
+             for number, topic in enumerate(paths)]
     result = processes.start('result', ['rostopic', 'echo', '-n', '1', '/move_base/result'])
-    # As fast as possible, the drive takes seconds: rviz is watched from the click on.
     goal = processes.start('goal', bash(NAV_GOAL))
-    seen, counts = [], []
-
-    def navigating():
-        image = screenshot(display)
-        plan = colour_pixels(image, (0, 0, 255), 30)
-        counts.append(plan)
-        if plan > 150:
-            seen[:] = [image, plan]
-        else:
-            save_png(image, os.path.join(SHOTS, 'navigation_last_without_plan.png'))
-        return bool(seen)
-    assert wait_until(navigating, 120, poll=0.5), 'no global plan drawn in rviz: plan pixels %s' % counts
-    image, plan = seen
-    os.makedirs(SHOTS, exist_ok=True)
-    save_png(image, os.path.join(SHOTS, 'navigation.png'))
-    particles = colour_pixels(image, (255, 25, 0), 30)
+    assert wait_until(lambda: not any(plan.running() for plan in plans), 120), \
+        'no plan on %s' % [topic for topic, plan in zip(paths, plans) if plan.running()]
+    image = shot(display, 'navigation.png')
+    subscribers = dict(master.getSystemState()[1])
+    poses = dict((topic, echoed(plan.output(None))['poses']) for topic, plan in zip(paths, plans))
+    for topic in paths:
+        print('MEASURED %s: %d poses, subscribers %s' % (topic, len(poses[topic]), subscribers.get(topic)))
+        assert poses[topic] and '/rviz' in subscribers.get(topic, []), (topic, subscribers.get(topic))
+    planned = poses['/move_base/NavfnROS/plan'][-1]['pose']['position']
+    assert math.hypot(planned['x'] - GOAL[0], planned['y'] - GOAL[1]) < 0.05, planned
+    particles = colour_pixels(image, PARTICLES, 10)
     costmap_cyan = colour_pixels(image, (0, 255, 255), 60)
-    print('MEASURED rviz while navigating: %d plan pixels, %d particle pixels, %d costmap (cyan) pixels'
-          % (plan, particles, costmap_cyan))
+    print('MEASURED rviz while navigating: %d particle pixels, %d costmap (cyan) pixels' % (particles, costmap_cyan))
     figure('nav_rviz_particle_pixels', particles, 'min', 'px')
     figure('nav_rviz_costmap_pixels', costmap_cyan, 'min', 'px')
     assert particles > 50 and costmap_cyan > 200
     assert goal.wait(TIMEOUT) == 0, goal.describe()
     assert wait_until(lambda: not result.running(), 180), 'no move_base result within 180 s'
-    echoed = result.output()  # rostopic may warn first ("Is /clock being published?")
-    outcome = yaml.safe_load(echoed[echoed.index('header:'):].split('---')[0])
+    outcome = echoed(result.output(None))
     x, y, yaw = truth_now()
     xy_error, yaw_error = math.hypot(x - GOAL[0], y - GOAL[1]), abs(math.remainder(yaw - GOAL[2], 2 * math.pi))
     print('MEASURED 2D Nav Goal: status %s, %s; truly %.3f m and %.3f rad off'
