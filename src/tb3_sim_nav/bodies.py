@@ -118,9 +118,13 @@ class Body(object):
         return link_frame(self.p, self.id, self.links[link])
 
     def teleport(self, pose, linear=(0.0, 0.0, 0.0), angular=(0.0, 0.0, 0.0)):
-        """The model frame to `pose`, moving at `linear` and `angular` (world axes)."""
+        """The model frame to `pose`, moving at `linear` and `angular` (world axes). A static body
+        stays still whatever twist it is given, as in Gazebo (pybullet moved a body of mass 0 on
+        at that twist forever, where the lidar did not see it go)."""
         position, orientation = compose(pose, self.frame_offset)
         self.p.resetBasePositionAndOrientation(self.id, position, orientation)
+        if self.static:
+            linear = angular = (0.0, 0.0, 0.0)
         self.p.resetBaseVelocity(self.id, linear, angular)
         self.wake()
         self.world.moved(self)

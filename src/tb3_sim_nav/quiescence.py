@@ -9,6 +9,7 @@ since a look a moment before, waits for something new from outside.
 """
 import os
 import platform
+import time
 
 #: Thread states of /proc/.../stat that will not act before something new
 #: arrives: asleep, stopped (Ctrl+Z), traced, dead. 'D' (disk) and 'R' will.
@@ -33,14 +34,19 @@ class ProcessWatch(object):
     """Watches the threads of one process; keeps their /proc files open, as
     reading an open file costs a fifth of opening it anew."""
 
-    def __init__(self, pid, proc='/proc'):
+    def __init__(self, pid, proc='/proc', exclude=()):
+        """`exclude`: ids of threads not to look at (a process watching its own other threads)."""
         self.pid = pid
         self._task_dir = os.path.join(proc, str(pid), 'task')
         if not os.path.isdir(self._task_dir):
             raise ProcessGone(pid)
+        self._exclude = set(str(tid) for tid in exclude)
         self._files = {}  # tid -> (stat fd, schedstat fd or None)
         self._busy = None  # the thread last seen running or runnable
         self._counted = os.path.exists(os.path.join(self._task_dir, str(pid), 'schedstat'))
+        self._last = None  # the run counters when last seen waiting
+        #: After waiting(): whether it ran since it was last seen waiting (True when it is not waiting).
+        self.ran = True
 
     def close(self):
         for tid in list(self._files):
@@ -61,7 +67,7 @@ class ProcessWatch(object):
 
     def _threads(self):
         try:
-            tids = os.listdir(self._task_dir)
+            tids = [tid for tid in os.listdir(self._task_dir) if tid not in self._exclude]
         except OSError:
             raise ProcessGone(self.pid)
         for tid in set(self._files) - set(tids):
@@ -106,13 +112,28 @@ class ProcessWatch(object):
         """
         threads = self._threads()  # one listing: a thread started in between means one ran
         busy = self._files.get(self._busy)
+        self.ran = True
         try:
             if busy is not None and not self._sleeps(busy[0]):
                 return False
         except (OSError, ValueError, IndexError):
             pass
         first = self._look(threads, states=not self._counted)
-        return first is not None and self._look(threads, states=True) == first
+        if first is None or self._look(threads, states=True) != first:
+            return False
+        self.ran, self._last = first != self._last, first
+        return True
+
+    def quiet(self, pause, sleep=time.sleep):
+        """True when every thread sleeps at two looks `pause` s apart and none ran in between: for a
+        process looking at its own other threads, which need the interpreter's lock to run and get it
+        in the pause."""
+        threads = self._threads()
+        first = self._look(threads, states=True)
+        if first is None:
+            return False
+        sleep(pause)
+        return self._look(self._threads(), states=True) == first
 
 
 class InputWaits(object):

@@ -24,6 +24,7 @@ class Robot(object):
         self.limits = Limits(config.max_linear_speed or model.limits.max_linear,
                              config.max_angular_speed or model.limits.max_angular)
         self.drive = Drive(model.geometry)
+        self.rng, self._rng_start = rng, rng.bit_generator.state
         self.sensors = [sensor for kind in KINDS for sensor in kind.build(body, model, config, rng)]
         self.configure(config)
         self.reset()
@@ -66,6 +67,10 @@ class Robot(object):
         self.body.set_wheel_speeds(0.0, 0.0)
         for sensor in self.sensors:
             sensor.reset()
+
+    def restart_noise(self):
+        """Every noise source of the robot (one stream) back to where it started."""
+        self.rng.bit_generator.state = self._rng_start
 
     # --- readings, for tests and tools: the ROS edge reads the sensors ---------
     def truth(self):

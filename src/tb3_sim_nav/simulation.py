@@ -83,9 +83,14 @@ class Simulation(object):
             self.world.objects[name].teleport(pose)
 
     def reset_simulation(self):
-        """reset_world, and time back to zero."""
+        """reset_world, and time back to zero; with a ~seed, every robot's noise also starts again
+        from it, so that what comes after a reset does not depend on how long the simulation ran
+        before it (a learning agent's episodes are then the same at any real-time factor)."""
         self.reset_world()
         self.steps = self.now_ns = 0
+        if self.config.seed >= 0:
+            for robot in self.robots.values():
+                robot.restart_noise()
 
     def set_time_step(self, seconds):
         """Physics steps of `seconds` from now on; sim time runs on without a jump."""

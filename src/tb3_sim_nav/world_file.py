@@ -1,16 +1,32 @@
-"""World files: static boxes and cylinders on the ground plane, and robots, in YAML.
+"""World files: boxes and cylinders on the ground plane, and robots, in YAML.
 
     # worlds/example.yaml
     obstacles:
       - box: {size: [4.0, 0.1, 0.4], position: [0.0, 2.0], yaw: 0.0, name: north_wall}
       - cylinder: {radius: 0.15, height: 0.4, position: [1.1, 1.1]}
+      - cylinder: {radius: 0.12, height: 0.25, position: [2.0, 2.0], name: ball, mass: 1.0}
+      - model:
+          name: spinner
+          mass: 1.0
+          inertia: [1.0, 1.0, 1.0]
+          shapes:
+            - cylinder: {radius: 0.15, height: 0.5, position: [-0.6, 0.0]}
+            - cylinder: {radius: 0.15, height: 0.5, position: [0.6, 0.0]}
     robots:
       - {name: tb3_3, model: burger, position: [-1.0, 0.5], yaw: 1.57}
 
 Units are metres and radians. `position` is [x, y] of the shape's centre
 (or [x, y, z]; z defaults to half the height, so the shape stands on the
 ground); `yaw` (default 0) turns it about z; `color` is an optional
-[r, g, b, a] in 0..1; `name` is optional and unique. A robot's `position`
+[r, g, b, a] in 0..1; `name` is optional and unique. An obstacle is a
+static model of its own, unless it has a `mass` (kg): then it is a dynamic
+one, which a twist given through Gazebo's set_model_state moves and which
+the robots can push, as a Gazebo model that is not <static>. A `model`
+makes one model of several shapes (given where they stand in the world):
+static, or dynamic with its `mass`; its centre of mass is the shapes'
+centroid. `inertia` [ixx, iyy, izz] (kg m^2, about the centre of mass) is
+optional: pybullet's estimate from the shapes otherwise, and Gazebo's
+default [1, 1, 1] for a model whose SDF has no <inertial>. A robot's `position`
 is that of its base_footprint (z defaults to 0), its `name` its namespace
 and tf prefix, its `model` burger, waffle, waffle_pi or the path of a URDF.
 A world named without a path ("empty", "turtlebot3_world") is a file of
@@ -33,7 +49,10 @@ import yaml
 DEFAULT_COLOR = (0.75, 0.75, 0.72, 1.0)
 
 #: kind is 'box' (size = (x, y, z) edge lengths) or 'cylinder' (size = (radius, height)).
-Obstacle = namedtuple('Obstacle', 'kind size position yaw color name', defaults=('',))
+#: `model`: the model it is part of ('' for a model of its own, named `name`); `mass`: its
+#: model's (kg), 0 for a static model; `inertia`: its model's (ixx, iyy, izz), None for pybullet's.
+Obstacle = namedtuple('Obstacle', 'kind size position yaw color name model mass inertia',
+                      defaults=('', '', 0.0, None))
 
 #: A robot to spawn: `name` ('' for the tutorial's robot without a namespace),
 #: `model` (burger, waffle, waffle_pi or a URDF path), `position` (x, y, z), `yaw`.
@@ -45,7 +64,8 @@ MAP_WALL_HEIGHT = 0.5  # m: above every TurtleBot3's lidar (0.182 m on the Burge
 MAP_WALL_COLOR = (0.55, 0.6, 0.65, 1.0)
 
 _SHAPE_KEYS = {'box': {'size'}, 'cylinder': {'radius', 'height'}}
-_OPTIONAL_KEYS = {'position', 'yaw', 'color', 'name'}
+_OPTIONAL_KEYS = {'position', 'yaw', 'color', 'name', 'mass', 'inertia'}
+_MODEL_KEYS = {'name', 'shapes', 'mass', 'inertia'}
 _ROBOT_KEYS = {'name', 'model', 'position', 'yaw'}
 ROBOT_NAME = re.compile(r'[A-Za-z][A-Za-z0-9_]*$')  # a ROS graph name without slashes
 
@@ -107,7 +127,47 @@ def _obstacle(entry):
     name = fields.get('name', '')
     if not isinstance(name, str):
         raise ValueError('name must be a string, not %r' % (name,))
-    return Obstacle(kind, size, position, yaw, color, name)
+    return Obstacle(kind, size, position, yaw, color, name, '', *_dynamics(fields))
+
+
+def _dynamics(fields):
+    """(mass, inertia) of an obstacle's or a model's fields: 0 and None for a static one."""
+    mass = _positive('mass', fields['mass']) if 'mass' in fields else 0.0
+    inertia = fields.get('inertia')
+    if inertia is not None:
+        if not mass:
+            raise ValueError('inertia needs a mass: a static model has none')
+        inertia = _numbers('inertia', inertia, (3,))
+        if min(inertia) <= 0.0:
+            raise ValueError('inertia must be > 0, not %r' % (fields['inertia'],))
+    return mass, inertia
+
+
+def _obstacles(entry):
+    """The Obstacles of one entry: a shape, or a `model` of several, each of them carrying the model's
+    name, mass and inertia."""
+    if not (isinstance(entry, dict) and list(entry) == ['model']):
+        return [_obstacle(entry)]
+    fields = entry['model']
+    if not isinstance(fields, dict) or not {'name', 'shapes'} <= set(fields) or set(fields) - _MODEL_KEYS:
+        raise ValueError('model needs a mapping of name and shapes (and optionally mass and inertia), not %r'
+                         % (fields,))
+    name, shapes = fields['name'], fields['shapes']
+    if not isinstance(name, str) or not name:
+        raise ValueError('a model needs a name, not %r' % (name,))
+    if not isinstance(shapes, list) or not shapes:
+        raise ValueError('model %s: shapes must be a list of boxes and cylinders, not %r' % (name, shapes))
+    parts = []
+    for index, shape in enumerate(shapes):
+        try:
+            part = _obstacle(shape)
+        except ValueError as error:
+            raise ValueError('model %s, shape %d: %s' % (name, index + 1, error))
+        if part.mass or part.inertia:
+            raise ValueError('model %s, shape %d: mass and inertia belong to the model' % (name, index + 1))
+        parts.append(part._replace(model=name))
+    mass, inertia = _dynamics(fields)
+    return [part._replace(mass=mass, inertia=inertia) for part in parts]
 
 
 def _robot(entry):
@@ -129,21 +189,26 @@ def _robot(entry):
 
 
 def _parse_list(entries, parse, what, where):
-    """[parse(entry) for each entry] of a YAML list, each name used once, or
-    WorldError naming `where`, the entry's number and the problem."""
+    """The items parse(entry) gives for each entry of a YAML list (one item, or a list of them),
+    each name used once, or WorldError naming `where`, the entry's number and the problem."""
     if entries is None:  # "robots:" with nothing after it
         entries = []
     if not isinstance(entries, (list, tuple)):
         raise WorldError('%s: "%ss" must be a list, not %r' % (where, what, entries))
-    items = []
+    items, names = [], []
     for index, entry in enumerate(entries):
         try:
-            items.append(parse(entry))
+            parsed = parse(entry)
         except ValueError as error:
             raise WorldError('%s, %s %d: %s' % (where, what, index + 1, error))
-    names = [item.name for item in items if item.name]
+        if isinstance(parsed, list):  # a model's shapes, or an obstacle alone
+            items.extend(parsed)
+            names.append(parsed[0].model or parsed[0].name)
+        else:
+            items.append(parsed)
+            names.append(parsed.name)
     for name in names:
-        if names.count(name) > 1:
+        if name and names.count(name) > 1:
             raise WorldError('%s: two %ss are named %r' % (where, what, name))
     return items
 
@@ -151,6 +216,18 @@ def _parse_list(entries, parse, what, where):
 def parse_robots(entries, where='~robots'):
     """RobotSpecs of a list of robot mappings, or WorldError saying which entry is wrong."""
     return _parse_list(entries, _robot, 'robot', where)
+
+
+def models_of(obstacles):
+    """(index of its first obstacle, name, its obstacles) of each model of a world file's obstacles, in
+    order: an obstacle is a model of its own (named by its name, else KIND_N) unless it names one."""
+    models = {}
+    for index, obstacle in enumerate(obstacles):
+        name = obstacle.model or obstacle.name or '%s_%d' % (obstacle.kind, index + 1)
+        if name in models and not (obstacle.model and models[name][2][0].model == obstacle.model):
+            raise ValueError('obstacle %d: two obstacles are named %r' % (index + 1, name))
+        models.setdefault(name, (index, name, []))[2].append(obstacle)
+    return list(models.values())
 
 
 def rectangles(mask):
@@ -217,5 +294,5 @@ def load_world(world, worlds_folder, map_wall_height=MAP_WALL_HEIGHT):
                          '"obstacles" and "robots", not %r' % (path, sorted(document) if isinstance(document, dict)
                                                               else document))
     where = 'world file %s' % path
-    return WorldSpec(_parse_list(document.get('obstacles'), _obstacle, 'obstacle', where),
+    return WorldSpec(_parse_list(document.get('obstacles'), _obstacles, 'obstacle', where),
                      _parse_list(document.get('robots'), _robot, 'robot', where))

@@ -137,7 +137,8 @@ def shapes_at_height(world_file, height):
     with open(world_file) as stream:
         entries = yaml.safe_load(stream)['obstacles']
     shapes = []
-    for entry in entries:
+    # A model's shapes stand where the file puts them, as the others do.
+    for entry in [shape for entry in entries for shape in entry.get('model', {}).get('shapes', [entry])]:
         ((kind, fields),) = entry.items()
         tall = fields['size'][2] if kind == 'box' else fields['height']
         position = fields.get('position', [0.0, 0.0])

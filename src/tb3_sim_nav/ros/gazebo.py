@@ -82,7 +82,8 @@ class GazeboInterface(object):
         self._warn = warn
         self.model_states = publishers.advertise('gazebo/model_states', ModelStates)
         self.link_states = publishers.advertise('gazebo/link_states', LinkStates)
-        rospy.Subscriber('gazebo/set_model_state', ModelState, self._on_set_model_state, queue_size=10)
+        self.set_model_state = rospy.Subscriber('gazebo/set_model_state', ModelState, self._on_set_model_state,
+                                                queue_size=10)
         for name, kind, handler in (
                 ('get_model_state', GetModelState, self._get_model_state),
                 ('set_model_state', SetModelState, self._set_model_state),
@@ -118,10 +119,10 @@ class GazeboInterface(object):
             self.link_states.publish(message)
 
     # --- requests, each answered in the step loop ----------------------------------
-    def _answer(self, response, work):
+    def _answer(self, response, work, request=None):
         """`response` with success and status_message, after `work()` in the step loop."""
         try:
-            status = self.requests.run(work)
+            status = self.requests.run(work, message=request)
             response.success, response.status_message = True, status or ''
         except (ModelStateError, ModelFileError, ModelError, ValueError) as error:
             response.success, response.status_message = False, str(error)
@@ -138,7 +139,7 @@ class GazeboInterface(object):
             response.header.stamp = messages.stamp_of(self.sim.now_ns)
             response.header.frame_id = request.relative_entity_name
             return 'GetModelState: got properties'
-        return self._answer(response, work)
+        return self._answer(response, work, request)
 
     def _set(self, state):
         pose, twist = _pose(state.pose), state.twist
@@ -148,11 +149,11 @@ class GazeboInterface(object):
         return 'SetModelState: set model state done'
 
     def _set_model_state(self, request):
-        return self._answer(SetModelStateResponse(), lambda: self._set(request.model_state))
+        return self._answer(SetModelStateResponse(), lambda: self._set(request.model_state), request)
 
     def _on_set_model_state(self, state):
         try:
-            self.requests.run(lambda: self._set(state))
+            self.requests.run(lambda: self._set(state), message=state)
         except (ModelStateError, ValueError) as error:
             self._warn('gazebo set_model_state topic', 'gazebo/set_model_state: %s' % error)
 
@@ -179,7 +180,7 @@ class GazeboInterface(object):
             self.sim.spawn_object(request.model_name, None, pose, urdf.static, urdf=request.model_xml)
             self.markers.changed()
             return 'SpawnModel: successfully spawned model %s' % request.model_name
-        return self._answer(SpawnModelResponse(), work)
+        return self._answer(SpawnModelResponse(), work, request)
 
     def _spawn_sdf_model(self, request):
         def work():
@@ -194,7 +195,7 @@ class GazeboInterface(object):
                 self.sim.spawn_object(request.model_name, shapes, pose, False, link.mass, frame_offset=link.pose)
             self.markers.changed()
             return 'SpawnModel: successfully spawned model %s' % request.model_name
-        return self._answer(SpawnModelResponse(), work)
+        return self._answer(SpawnModelResponse(), work, request)
 
     def _delete_model(self, request):
         def work():
@@ -203,9 +204,9 @@ class GazeboInterface(object):
                 self.fleet.forget(robot)
             self.markers.changed()
             return 'DeleteModel: successfully deleted model %s' % request.model_name
-        return self._answer(DeleteModelResponse(), work)
+        return self._answer(DeleteModelResponse(), work, request)
 
-    def _get_world_properties(self, _request):
+    def _get_world_properties(self, request):
         response = GetWorldPropertiesResponse()
 
         def work():
@@ -213,7 +214,7 @@ class GazeboInterface(object):
             response.model_names = self.sim.model_names()
             response.rendering_enabled = bool(self.sim.config.gui)
             return 'GetWorldProperties: got properties'
-        return self._answer(response, work)
+        return self._answer(response, work, request)
 
     def _get_model_properties(self, request):
         response = GetModelPropertiesResponse()
@@ -230,9 +231,9 @@ class GazeboInterface(object):
             response.joint_names = list(body.joint_names)
             response.is_static = body.static
             return 'GetModelProperties: got properties'
-        return self._answer(response, work)
+        return self._answer(response, work, request)
 
-    def _get_physics_properties(self, _request):
+    def _get_physics_properties(self, request):
         response = GetPhysicsPropertiesResponse()
 
         def work():
@@ -244,7 +245,7 @@ class GazeboInterface(object):
             response.ode_config = ODEPhysics(**ODE_DEFAULTS)
             return ('GetPhysicsProperties: pybullet steps at time_step; max_update_rate / (1 / time_step) is the '
                     'real-time factor (0: as fast as possible); ode_config is Gazebo\'s default, unused here')
-        return self._answer(response, work)
+        return self._answer(response, work, request)
 
     def _set_physics_properties(self, request):
         def work():
@@ -263,4 +264,4 @@ class GazeboInterface(object):
             rospy.loginfo('set_physics_properties: time step %g s, real-time factor %g (0: as fast as possible), '
                           'gravity %s', step, rate * step, gravity)
             return 'SetPhysicsProperties: done (ode_config is not used here)'
-        return self._answer(SetPhysicsPropertiesResponse(), work)
+        return self._answer(SetPhysicsPropertiesResponse(), work, request)

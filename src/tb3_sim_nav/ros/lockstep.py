@@ -3,6 +3,8 @@
 See Lockstep's docstring; quiescence.py reads the processes' state off /proc.
 """
 import math
+import os
+import threading
 import time
 import xmlrpc.client
 
@@ -77,6 +79,8 @@ class Lockstep(object):
         self._watches = {}   # publisher node name -> ProcessWatch of its process
         self._behind = set()  # node names not waited for until seen waiting
         self.receive_threads = InputWaits()  # the threads that ran our cmd_vel callbacks
+        self._ran = set()  # nodes seen running since this process's other threads were last seen asleep
+        self._own = None  # ProcessWatch of this process's threads but the step loop's
 
     def follow(self, subscriber):
         """Wait also for the publishers of `subscriber` (a robot's cmd_vel)."""
@@ -165,21 +169,20 @@ class Lockstep(object):
 
     def _reacted(self, name):
         try:
-            return self._watches[name].waiting()
+            watch = self._watches[name]
+            waiting = watch.waiting()
         except ProcessGone:  # it ended: nothing more will come from it
             return True
+        if watch.ran:
+            self._ran.add(name)
+        return waiting
 
-    def wait(self):
-        self._follow_publishers()
-        # A node left behind and now seen waiting has reacted: no second look.
-        recovered = set(name for name in self._behind if self._reacted(name))
-        self._behind -= recovered
-        pending = [name for name in self._watches if name not in self._behind and name not in recovered]
-        deadline = time.monotonic() + self._timeout
+    def _settle(self, pending, deadline):
+        """Waits until the nodes `pending` have reacted; False (they are left behind) at `deadline`."""
         while True:
             pending = [name for name in pending if not self._reacted(name)]
             if not pending:
-                break
+                return True
             if time.monotonic() > deadline:
                 self._behind.update(pending)
                 # Not a fault (Gazebo never waits for a node), but from here on
@@ -192,12 +195,58 @@ class Lockstep(object):
                                   'programs beside it, a lower real_time_factor, or a longer ~lockstep_timeout (at '
                                   'most one such message per %g s)',
                                   ', '.join(pending), self._timeout, self._warn_period)
-                return
+                return False
             time.sleep(self._poll)
+
+    def _own_threads_settled(self, deadline):
+        """Waits until this process's threads but the step loop's sleep (what a node asked of Gazebo's
+        services or topic has reached the request queue; answers are written); False at `deadline`."""
+        if self._own is None:
+            self._own = ProcessWatch(os.getpid(), exclude=(threading.get_native_id(),))
+        while not self._own.quiet(self._poll):
+            if time.monotonic() > deadline:
+                return False
+        return True
+
+    def wait(self, requests=None):
+        """Waits until the nodes followed have reacted to the last step; with `requests` (loop.Requests),
+        also serves what they asked for meanwhile, and waits for their reaction to the answers."""
+        self._follow_publishers()
+        # A node left behind and now seen waiting has reacted: no second look.
+        recovered = set(name for name in self._behind if self._reacted(name))
+        self._behind -= recovered
+        pending = [name for name in self._watches if name not in self._behind and name not in recovered]
+        deadline = time.monotonic() + self._timeout
+        if not self._settle(pending, deadline):
+            return
         # The commands they sent are read: let our callback have handled them.
         while not self.receive_threads.all_waiting():
             if time.monotonic() > deadline:
                 return
             time.sleep(self._poll)
+        if requests is not None:
+            self._serve(requests, deadline)
+
+    def _serve(self, requests, deadline):
+        """A node that calls Gazebo's services waits for the answer, asleep: lockstep sees it waiting
+        while its request may still be on its way through this process's threads (or its answer on
+        the way back). So, when such a node ran since this process's threads were last seen asleep,
+        they must sleep (the request is queued) before the queue is served, and after each request
+        served (the answer is written), and the node must then have reacted again: its requests land
+        between the same two steps at any factor, as its commands do."""
+        while True:
+            callers = [name for name in self._watches if name in requests.callers and name not in self._behind]
+            if self._ran.intersection(callers):
+                if not self._own_threads_settled(deadline):
+                    return
+                self._ran.clear()
+                # Our threads' writes (a handshake's reply, an answer) may have woken one.
+                if not self._settle(callers, deadline):
+                    return
+                if self._ran.intersection(callers):
+                    continue
+            if not requests.serve():
+                return
+            self._ran.update(callers)  # answers on their way: they will react
 
 

@@ -23,9 +23,14 @@ class Requests(object):
     def __init__(self, life):
         self.life = life
         self._queue = queue.Queue()
+        self.callers = set()  # the nodes that asked for something: lockstep serves them before each step
 
-    def run(self, work, timeout=REQUEST_TIMEOUT):
-        """work()'s result, run by the step loop between steps; its exception raised here."""
+    def run(self, work, timeout=REQUEST_TIMEOUT, message=None):
+        """work()'s result, run by the step loop between steps; its exception raised here. `message`:
+        the request or message that asked for it, whose caller lockstep then knows."""
+        caller = getattr(message, '_connection_header', {}).get('callerid')
+        if caller:
+            self.callers.add(caller)
         done, result = threading.Event(), {}
         self._queue.put((work, done, result))
         deadline = time.monotonic() + timeout
@@ -39,12 +44,14 @@ class Requests(object):
         return result.get('value')
 
     def serve(self):
-        """Run what waits (in the step loop)."""
+        """Run what waits (in the step loop); how many there were."""
+        served = 0
         while True:
             try:
                 work, done, result = self._queue.get_nowait()
             except queue.Empty:
-                return
+                return served
+            served += 1
             try:
                 result['value'] = work()
             except Exception as error:  # handed back to the thread that asked

@@ -71,6 +71,8 @@ class SimulatorNode(object):
         self.markers = Markers(simulation, self.publishers, config.world_frame or config.odom_frame)
         self.gazebo = GazeboInterface(simulation, self.publishers, self.requests, self.fleet, self.markers,
                                       self.pacer, self.warn_throttled)
+        if self.lockstep:  # ROBOTIS' moving obstacles (turtlebot3_dqn) move models through this topic
+            self.lockstep.follow(self.gazebo.set_model_state)
         self.reconfigure = Reconfigure(simulation, self.requests)
         self._own_clock = rospy_internals.stop_following_clock()
         for name, handler in (('pause_physics', self._on_pause), ('unpause_physics', self._on_unpause),
@@ -101,8 +103,8 @@ class SimulatorNode(object):
         self.sim.reset_world()
         self.markers.changed()
 
-    def _on_reset_world(self, _request):
-        self.requests.run(self._reset_world)
+    def _on_reset_world(self, request):
+        self.requests.run(self._reset_world, message=request)
         rospy.loginfo('reset_world: every robot and object back at its spawn pose, odometry zeroed')
         return EmptyResponse()
 
@@ -111,8 +113,8 @@ class SimulatorNode(object):
         self.pacer.restart()
         self.markers.changed()
 
-    def _on_reset_simulation(self, _request):
-        self.requests.run(self._reset_simulation)
+    def _on_reset_simulation(self, request):
+        self.requests.run(self._reset_simulation, message=request)
         rospy.loginfo('reset_simulation: every robot and object back at its spawn pose, time back to zero')
         return EmptyResponse()
 
@@ -128,10 +130,11 @@ class SimulatorNode(object):
                 time.sleep(IDLE_POLL)
                 continue
             self.pacer.wait_until((self.sim.now_ns + self.sim.step_ns) * 1e-9)
-            # Each step waits for the nodes' reaction to the last tick. Paced,
-            # they have had the sleep to react: one look mostly finds them done.
+            # Each step waits for the nodes' reaction to the last tick, and serves
+            # what they asked of Gazebo's services meanwhile. Paced, they have had
+            # the sleep to react: one look mostly finds them done.
             if self.lockstep:
-                self.lockstep.wait()
+                self.lockstep.wait(self.requests)
             self.step()
 
     def step(self):
