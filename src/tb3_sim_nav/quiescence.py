@@ -45,6 +45,7 @@ class ProcessWatch(object):
         self._busy = None  # the thread last seen running or runnable
         self._counted = os.path.exists(os.path.join(self._task_dir, str(pid), 'schedstat'))
         self._last = None  # the run counters when last seen waiting
+        self._quiet = None  # the run counters when last seen quiet (quiet())
         #: After waiting(): whether it ran since it was last seen waiting (True when it is not waiting).
         self.ran = True
 
@@ -132,8 +133,17 @@ class ProcessWatch(object):
         first = self._look(threads, states=True)
         if first is None:
             return False
+        if self._counted and first == self._quiet:
+            # None ran since they were last seen quiet: a thread that received since would have run (a
+            # thread woken but not yet run is runnable, not asleep). Most steps end here: the pause cost
+            # a step 0.1 ms and more (a sleep's wake-up on a loaded machine).
+            return True
         sleep(pause)
-        return self._look(self._threads(), states=True) == first
+        second = self._look(self._threads(), states=True)
+        if second != first:
+            return False
+        self._quiet = second
+        return True
 
 
 class InputWaits(object):

@@ -86,6 +86,7 @@ class Simulation(object):
         """reset_world, and time back to zero; with a ~seed, every robot's noise also starts again
         from it, so that what comes after a reset does not depend on how long the simulation ran
         before it (a learning agent's episodes are then the same at any real-time factor)."""
+        self.world.forget_the_past()
         self.reset_world()
         self.steps = self.now_ns = 0
         if self.config.seed >= 0:

@@ -186,3 +186,35 @@ def test_without_a_seed_or_with_reset_world_the_noise_runs_on(make):
     start = robot.scan()
     simulation.reset_world()
     assert not np.array_equal(robot.scan(), start)
+
+
+def drive_after_reset(simulation, before):
+    """The robot's true pose (exact) after 300 steps of one command sequence that follows reset_simulation;
+    `before(simulation)` is what came before the reset."""
+    robot = simulation.robots['']
+    before(simulation)
+    simulation.reset_simulation()
+    for step in range(300):
+        robot.command(0.15, 0.75 if (step // 40) % 2 else -0.75, simulation.now_ns)
+        simulation.step()
+    (position, orientation), _ = robot.truth()
+    return tuple(position) + tuple(orientation)
+
+
+def stand(seconds):
+    return lambda simulation: [simulation.step() for _ in range(int(seconds * 100))]
+
+
+def drive(simulation):
+    for _ in range(250):
+        simulation.robots[''].command(0.2, 1.0, simulation.now_ns)
+        simulation.step()
+
+
+@pytest.mark.parametrize('world', ['turtlebot3_stage_1', 'turtlebot3_stage_3'])
+def test_what_follows_reset_simulation_does_not_depend_on_what_came_before(make, world):
+    # Before Bullet was made to forget contacts and sleep (World.forget_the_past), a robot that had stood
+    # 2 s and slept lost the first step after the reset: 0.1 mm off after 3 s.
+    first = drive_after_reset(make(world, seed=3), stand(0.5))
+    for before in (stand(4.0), drive, stand(0.0)):
+        assert drive_after_reset(make(world, seed=3), before) == first

@@ -189,3 +189,24 @@ def test_a_thread_waits_for_input_only_while_blocked_reading_its_socket():
     assert eventually(receivers.all_waiting), 'an ended thread has nothing left to handle'
     receivers.clear()
     assert receivers.all_waiting(), 'no thread followed: nothing to wait for'
+
+
+def test_own_threads_are_quiet_after_a_pause_and_then_until_one_runs(tmp_path):
+    """quiet(): two looks a pause apart the first time; afterwards one look, unless a thread ran since."""
+    task = tmp_path / '8' / 'task'
+    write_thread(task, 8, b'8 (step loop) R 1 8', schedstat=b'1 0 1\n')
+    write_thread(task, 9, b'9 (service) S 1 8', schedstat=b'1000 0 3\n')
+    watch = ProcessWatch(8, proc=str(tmp_path), exclude=(8,))
+    pauses = []
+    assert watch.quiet(0.001, sleep=pauses.append) and pauses == [0.001]
+    assert watch.quiet(0.001, sleep=pauses.append) and pauses == [0.001], 'nothing ran: no second look'
+    write_thread(task, 9, b'9 (service) S 1 8', schedstat=b'1500 0 4\n')  # it ran (a request came)
+    assert watch.quiet(0.001, sleep=pauses.append) and len(pauses) == 2
+    write_thread(task, 9, b'9 (service) R 1 8', schedstat=b'1500 0 4\n')  # woken, not yet run
+    assert not watch.quiet(0.001, sleep=pauses.append)
+
+    def runs_in_the_pause(_pause):
+        write_thread(task, 9, b'9 (service) S 1 8', schedstat=b'1900 0 5\n')
+    write_thread(task, 9, b'9 (service) S 1 8', schedstat=b'1600 0 5\n')
+    assert not watch.quiet(0.001, sleep=runs_in_the_pause)
+    watch.close()

@@ -205,7 +205,12 @@ class Lockstep(object):
             self._own = ProcessWatch(os.getpid(), exclude=(threading.get_native_id(),))
         while not self._own.quiet(self._poll):
             if time.monotonic() > deadline:
+                if self._warnings.allow('lockstep requests'):
+                    rospy.logwarn('lockstep: a request to Gazebo\'s services did not reach the step loop within %g s '
+                                  '(wall): it is served a step or more later than on a quiet machine (at most one '
+                                  'such message per %g s)', self._timeout, self._warn_period)
                 return False
+            time.sleep(self._poll)  # a thread that is not asleep may need the interpreter's lock
         return True
 
     def wait(self, requests=None):
@@ -248,5 +253,6 @@ class Lockstep(object):
             if not requests.serve():
                 return
             self._ran.update(callers)  # answers on their way: they will react
+            deadline = time.monotonic() + self._timeout  # each reaction to an answer has its own time
 
 
