@@ -28,6 +28,11 @@ line per frontier and per goal as it goes; a table in OUTPUT/explore.txt; the
 map under the house's outline with the exploration's and the navigation's true
 paths in OUTPUT/explore.png.
 
+With --dqn (`make demo DEMO_ARGS="--dqn"`) ROBOTIS' DQN agent trains in stage
+1 for a few episodes (tb3_harness/dqn.py): turtlebot3_stage_1.launch and
+turtlebot3_dqn_stage_1.launch; a table in OUTPUT/dqn.txt, the graph of score
+and average max Q per episode in OUTPUT/dqn_result.png, models in OUTPUT/dqn/.
+
 Every walkthrough runs as fast as possible unless --real-time-factor says
 (`--real-time-factor 1`: at real time): it is headless, and lockstep makes a
 script's path the same at every factor (the speed-agreement test checks it).
@@ -56,7 +61,7 @@ import subprocess
 import sys
 import time
 
-from tb3_harness import calibration, exploring, leftovers, mapping, navigating, report
+from tb3_harness import calibration, dqn, exploring, leftovers, mapping, navigating, report
 from tb3_harness.processes import RunError, say, start_master
 from tb3_harness.tutorial import LAUNCH, SCRIPTS, run_script
 from tb3_sim_nav.robot_model import TURTLEBOT3_MODELS
@@ -91,10 +96,12 @@ def parse_args(argv):
                         help='navigate turtlebot3_world to four goals (profile realistic), instead of the tutorial')
     parser.add_argument('--explore', action='store_true',
                         help='map turtlebot3_house alone, save the map, navigate four rooms on it (profile realistic)')
+    parser.add_argument('--dqn', action='store_true',
+                        help='train ROBOTIS\' DQN agent in stage 1 for %d episodes, headless' % dqn.DEMO_EPISODES)
     args = parser.parse_args(argv)
-    mapping_chapters = args.slam or args.nav or args.explore
-    if args.calibrate + args.slam + args.nav + args.explore > 1:
-        parser.error('--calibrate, --slam, --nav and --explore are walkthroughs of their own: one at a time')
+    mapping_chapters = args.slam or args.nav or args.explore or args.dqn
+    if args.calibrate + args.slam + args.nav + args.explore + args.dqn > 1:
+        parser.error('--calibrate, --slam, --nav, --explore and --dqn are walkthroughs of their own: one at a time')
     if mapping_chapters and (args.scripts or args.profile not in (None, 'realistic')):
         parser.error('--slam, --nav and --explore run their own drives in profile realistic: no --scripts, '
                      'no other --profile')
@@ -159,7 +166,7 @@ def main(argv=None):
     signal.signal(signal.SIGTERM, on_sigterm)
     signal.signal(signal.SIGINT, signal.default_int_handler)  # even if started with SIGINT ignored
 
-    calibrated = mapped = navigated = explored = None
+    calibrated = mapped = navigated = explored = trained = None
     scripts = [(name, expected) for name, expected in SCRIPTS if not args.scripts or name in args.scripts]
     master = None
     results, failures = [], []
@@ -186,7 +193,10 @@ def main(argv=None):
             navigated = navigating.navigate_world(log_dir, factor=args.real_time_factor, world='turtlebot3_house',
                                                   launch='tb3_house.launch', map_file=explored.map_yaml,
                                                   goals=navigating.HOUSE_GOALS, spawn=navigating.HOUSE_SPAWN)
-        for script, expected in scripts if not (args.calibrate or args.slam or args.nav or args.explore) else ():
+        if args.dqn:
+            trained = dqn.train(log_dir, args.output, factor=args.real_time_factor)
+        for script, expected in scripts if not (args.calibrate or args.slam or args.nav or args.explore or args.dqn) \
+                else ():
             # Started paused, time starting once the script has connected: as fast as possible
             # the simulator would otherwise run some 80 sim s while python starts the script.
             result, error = run_script(script, expected, argparse.Namespace(paused_start=True, **vars(args)), log_dir)
@@ -222,6 +232,8 @@ def main(argv=None):
     elif navigated is not None:
         write_walkthrough(args, navigating.table(navigated), total, 'nav.txt', 'nav_paths.png',
                           lambda picture: navigating.draw(navigated, picture))
+    if trained is not None:
+        write_walkthrough(args, dqn.table(trained[0]), total, 'dqn.txt', 'dqn_result.png', trained[1])
     model = args.model or os.environ.get('TURTLEBOT3_MODEL', 'burger')
     if results:
         header = ['tb3_sim_nav demo: the tutorial\'s scripts on the pybullet TurtleBot3 %s' % model,

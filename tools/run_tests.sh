@@ -95,6 +95,9 @@ part 2 test_emanual "$pytest test/system/test_emanual.py"
 part 2 test_turtlebot3_gazebo "$pytest test/system/test_turtlebot3_gazebo.py"
 part 2 test_real_node_names "$pytest test/system/test_real_node_names.py"
 part 2 test_wiki_style_navigation "$pytest test/system/test_wiki_style_navigation.py"
+# The machine-learning chapter (issue 30): the agent trains as fast as possible (a core), then the first
+# episodes at factors 1 and 0 against each other.
+part 2 test_dqn "$pytest test/system/test_dqn.py"
 # The root package's unit tests and every package's own (packages/*/test).
 [ -n "$integration_only" ] || part 2 unit "$pytest test/unit $(ls -d packages/*/test)"
 part 2 test_calibration.busy_core "$pytest test/system/test_calibration.py -k busy_core"
