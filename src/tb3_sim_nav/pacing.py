@@ -64,9 +64,13 @@ class Schedule(object):
         self.period_ns = int(period_ns)
         self.next_ns = 0
 
+    def restart(self):
+        """Due at the next step, as at start (time went back to zero: reset_simulation). Said, not
+        guessed from the time: a reset within the first period looked like no reset, and the first
+        scan after it came a period late at one factor and not at the other."""
+        self.next_ns = 0
+
     def due(self, now_ns):
-        if now_ns < self.next_ns - self.period_ns:  # time went back (a reset): start again
-            self.next_ns = now_ns
         if now_ns < self.next_ns:
             return False
         self.next_ns += self.period_ns

@@ -10,8 +10,11 @@ On one simulator (tb3_empty_world.launch, spawn (0, 0), yaw 0), in order:
    tf2_ros.TransformListener and a tf.TransformListener made before the jump
    give odom -> base_footprint again, with post-jump stamps, within a few
    seconds (they must clear their buffers on the jump);
-3. reset_simulation, and at once `rosrun tb3_sim_nav odom_out_and_back.py`: it
-   drives 1 m out and back and ends within 5 cm and 5 deg of where it started.
+3. reset_simulation, and once time has run on a step, again (a learning
+   agent's set-up, then its first episode), and at once `rosrun tb3_sim_nav
+   odom_out_and_back.py`: after each reset a scan comes at the first step, as
+   after a start; the script drives 1 m out and back and ends within 5 cm and
+   5 deg of where it started.
 Each phase runs once (setUpClass); each test method checks one promise of one
 phase, and says so if its phase could not run.
 """
@@ -26,6 +29,7 @@ import tf2_ros
 from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty
 
 from script_test_case import ScriptTestCase
@@ -53,6 +57,7 @@ STOPPED_SPEED = 0.01         # m/s
 DRIVE_SECONDS = 2.0          # sim s of driving before each reset
 AFTER_RESET = 1.5            # sim s watched after each reset
 NEAR_ZERO = 1.0              # sim s: /clock's first value after reset_simulation is below this
+FIRST_STEP = 0.05            # sim s: a scan (5 Hz) is due at the first step after a start or reset
 TF_WITHIN = 5.0              # wall s for the tf listeners to give a post-jump transform
 
 
@@ -110,6 +115,7 @@ class Resets(ScriptTestCase):
         cls.truth_all = GroundTruth()
         cls.odom = Recorder('/odom', Odometry, odom_sample)
         cls.clock = Recorder('/clock', Clock, lambda message: message.clock.to_sec())
+        cls.scan = Recorder('/scan', LaserScan, lambda message: message.header.stamp.to_sec())
         # Made before any reset: they must cope with the jump of sim time.
         cls.tf2_buffer = tf2_ros.Buffer()
         cls.tf2_listener = tf2_ros.TransformListener(cls.tf2_buffer)
@@ -354,10 +360,14 @@ class Resets(ScriptTestCase):
         if not truth.wait_until(3.0, wall_budget(3.0)):
             raise AssertionError('sim time did not reach 3 s after the last reset')
         before = cls.clock.latest()
-        truth_mark, clock_mark = truth.count(), cls.clock.count()
+        truth_mark, clock_mark, scan_mark = truth.count(), cls.clock.count(), cls.scan.count()
+        # Twice, a step or so apart: a reset within a scan's period of the one before once looked
+        # like none to the scan's schedule, and its first scan came 0.2 s late (an agent's episode
+        # then started a scan later at one real-time factor than at another).
+        cls._call('/gazebo/reset_simulation')
+        cls.script_first_clock = cls._wait_for_jump(clock_mark, before)
         cls._call('/gazebo/reset_simulation')
         cls.child = Child(['rosrun', 'tb3_sim_nav', cls.script])
-        cls.script_first_clock = cls._wait_for_jump(clock_mark, before)
         budget = wall_budget(cls.script_sim_seconds)
         cls.exit_code = cls.child.wait(budget)
         cls.output = cls.child.output()
@@ -370,6 +380,7 @@ class Resets(ScriptTestCase):
         if not path:
             raise AssertionError('ground truth never jumped back')
         cls.start, cls.end = path[0], path[-1]
+        cls.first_scans = [stamp for stamp in cls.scan.since(scan_mark) if stamp < FIRST_STEP]
         cls.path = path
         cls.position_error = math.hypot(cls.end.x - cls.start.x, cls.end.y - cls.start.y)
         cls.heading_error = math.degrees(abs(wrap(cls.end.yaw - cls.start.yaw)))
@@ -377,7 +388,8 @@ class Resets(ScriptTestCase):
         cls.max_excursion = max(math.hypot(x, y) for x, y in cls.local_path)
         cls.total_turn = math.degrees(unwrapped_turn(path))
         report('%s_after_reset_simulation' % cls.script, exit_code=cls.exit_code,
-               first_clock=cls.script_first_clock, start_stamp=cls.start.t, sim_seconds=cls.end.t - cls.start.t,
+               first_clock=cls.script_first_clock, first_scans=cls.first_scans, start_stamp=cls.start.t,
+               sim_seconds=cls.end.t - cls.start.t,
                position_error_m=cls.position_error, heading_error_deg=cls.heading_error,
                max_excursion_m=cls.max_excursion, total_turn_deg=cls.total_turn)
         cls.done_script = True
@@ -386,6 +398,11 @@ class Resets(ScriptTestCase):
         self.need('script')
         self.assertLess(off_spawn(self.start)[0], POSITION_TOLERANCE)
         self.assertLess(self.start.t, NEAR_ZERO + 1.0, 'the path does not start at the jump')
+
+    def test_a_scan_comes_at_the_first_step_after_each_reset_simulation(self):
+        self.need('script')
+        self.assertEqual(len(self.first_scans), 2, 'scans stamped before %g s after two resets: %s'
+                         % (FIRST_STEP, self.first_scans))
 
     def test_script_after_reset_simulation_exits_with_code_0(self):
         self.need('script')

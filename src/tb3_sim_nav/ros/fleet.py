@@ -71,6 +71,12 @@ class Fleet(object):
                  for sensor in robot.sensors]
         return max(rates, key=lambda item: item[1]) if rates else ('physics_rate', 0.0)
 
+    def restart_schedules(self):
+        """Every output due at the next step, as at start: sim time went back to zero."""
+        for io in self.robots.values():
+            for sensor in io.sensors:
+                sensor.schedule.restart()
+
     def apply_commands(self, now_ns):
         for io in self.robots.values():
             io.apply_command(now_ns)

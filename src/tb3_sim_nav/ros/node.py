@@ -110,6 +110,7 @@ class SimulatorNode(object):
 
     def _reset_simulation(self):
         self.sim.reset_simulation()
+        self.fleet.restart_schedules()
         self.pacer.restart()
         self.markers.changed()
 
