@@ -18,8 +18,8 @@ import os
 import pytest
 import rospkg
 
-from tb3_harness.navigating import WORLD_GOALS, Navigation, clearance
-from tb3_harness.processes import Process, start_master, wait_until
+from tb3_harness.navigating import WORLD_GOALS, clearance, running
+from tb3_harness.processes import start_master
 from tb3_harness.report import figure
 
 SPAWN = (-2.0, -0.5, 0.0)  # tb3_world.launch's
@@ -42,26 +42,14 @@ def navigation(tmp_path_factory):
     import rospy
     folder = str(tmp_path_factory.mktemp('navigation'))
     master = start_master(folder)
-    started = []
     try:
         os.environ['TURTLEBOT3_MODEL'] = 'burger'
-        started.append(Process('sim', ['roslaunch', 'tb3_sim_bringup', 'tb3_world.launch', 'profile:=realistic',
-                                       'real_time_factor:=0'], folder, die_with_parent=True))
-        started.append(Process('nav', ['roslaunch', 'tb3_sim_bringup', 'tb3_navigation.launch', 'open_rviz:=false'],
-                               folder, die_with_parent=True))
         rospy.init_node('navigation_test', anonymous=True, disable_signals=True)
-        nav = Navigation()
-        nav.wait_ready()
-        wait_until(lambda: 'map of' in started[1].output(None), 60.0, 'the map in amcl and move_base',
-                   watch=started)
-        nav.set_pose(*SPAWN)
-        nav.logs = started
-        yield nav
-        nav.close()
+        with running(folder, ['tb3_sim_bringup', 'tb3_world.launch', 'profile:=realistic', 'real_time_factor:=0'],
+                     ['tb3_sim_bringup', 'tb3_navigation.launch', 'open_rviz:=false'], SPAWN) as nav:
+            yield nav
         rospy.signal_shutdown('navigation tests done')
     finally:
-        for process in reversed(started):
-            process.stop()
         master.stop()
 
 

@@ -22,8 +22,8 @@ import pytest
 import rospkg
 from test_navigation import world_obstacles
 
-from tb3_harness.navigating import BURGER_FOOTPRINT, Navigation, clearance, closest
-from tb3_harness.processes import Process, start_master, wait_until
+from tb3_harness.navigating import BURGER_FOOTPRINT, clearance, closest, running
+from tb3_harness.processes import start_master, wait_until
 from tb3_harness.report import figure
 
 from tb3_system_utils import run
@@ -126,25 +126,13 @@ def navigation(tmp_path_factory):
     with open(launch, 'w') as stream:
         stream.write(LAUNCH.format(map=os.path.join(package, 'maps', 'turtlebot3_world.yaml'), dir=folder))
     master = start_master(folder)
-    started = []
     try:
         os.environ['TURTLEBOT3_MODEL'] = 'burger'
-        started.append(Process('sim', ['roslaunch', 'tb3_sim_bringup', 'tb3_world.launch', 'real_time_factor:=0'],
-                               folder, die_with_parent=True))
-        started.append(Process('nav', ['roslaunch', launch], folder, die_with_parent=True))
         rospy.init_node('wiki_navigation_test', anonymous=True, disable_signals=True)
-        nav = Navigation()
-        nav.wait_ready()
-        wait_until(lambda: started[1].output(None).count('map of') >= 2, 60.0, 'the map in amcl and move_base',
-                   watch=started)
-        nav.set_pose(*SPAWN)
-        nav.logs = started
-        yield nav
-        nav.close()
+        with running(folder, ['tb3_sim_bringup', 'tb3_world.launch', 'real_time_factor:=0'], [launch], SPAWN) as nav:
+            yield nav
         rospy.signal_shutdown('wiki navigation tests done')
     finally:
-        for process in reversed(started):
-            process.stop()
         master.stop()
 
 

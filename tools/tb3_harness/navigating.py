@@ -9,6 +9,7 @@ the particle cloud's spread. Each goal's Outcome says how the action ended
 and where the robot truly stood, and clearance() how close its footprint
 came to the world's obstacles.
 """
+import contextlib
 import dataclasses
 import math
 import os
@@ -225,6 +226,30 @@ class NavigationRun(object):
     closest: tuple  # the true pose [t, x, y, yaw] where the footprint came closest
 
 
+@contextlib.contextmanager
+def running(log_dir, world_launch, navigation_launch, spawn):
+    """`roslaunch` of the world and of the navigation (argument lists) in `log_dir`, and once amcl and
+    move_base both have the map, a Navigation with a 2D Pose Estimate at `spawn`: yields it, its .logs
+    the two launches; stops them at the end, whatever happened. The caller is a rospy node (following
+    /clock) of a master of its own."""
+    from .processes import Process, wait_until
+    started = []
+    try:
+        started.append(Process('sim', ['roslaunch'] + list(world_launch), log_dir, die_with_parent=True))
+        started.append(Process('nav', ['roslaunch'] + list(navigation_launch), log_dir, die_with_parent=True))
+        wait_until(lambda: started[1].output(None).count('map of') >= 2, 60.0, 'the map in amcl and move_base',
+                   watch=started)
+        navigation = Navigation()
+        navigation.wait_ready()
+        navigation.set_pose(*spawn)
+        navigation.logs = started
+        yield navigation
+        navigation.close()
+    finally:
+        for process in reversed(started):
+            process.stop()
+
+
 def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD_GOALS, spawn=WORLD_SPAWN,
                    world='turtlebot3_world', launch='tb3_world.launch', map_file=None):
     """`launch` (tb3_world.launch) and tb3_navigation.launch on `map_file` (None: the world's
@@ -239,22 +264,13 @@ def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD
 
     from .mapping import _node_pid
     from .measure import cpu_seconds
-    from .processes import Process, wait_until
     rosgraph.Master('/tb3_harness').setParam('/tb3_sim/seed', seed)
     rosgraph.Master('/tb3_harness').setParam('/amcl/seed', seed)
     package = rospkg.RosPack().get_path('tb3_sim_nav')
     map_file = map_file or os.path.join(package, 'maps', world + '.yaml')
-    started = []
-    try:
-        started.append(Process('sim', ['roslaunch', 'tb3_sim_bringup', launch, 'profile:=%s' % profile,
-                                       'real_time_factor:=%g' % factor], log_dir, die_with_parent=True))
-        started.append(Process('nav', ['roslaunch', 'tb3_sim_bringup', 'tb3_navigation.launch', 'open_rviz:=false',
-                                       'map_file:=%s' % map_file], log_dir, die_with_parent=True))
-        wait_until(lambda: started[1].output(None).count('map of') >= 2, 60.0, 'the map in amcl and move_base',
-                   watch=started)
-        navigation = Navigation()
-        navigation.wait_ready()
-        navigation.set_pose(*spawn)
+    with running(log_dir, ['tb3_sim_bringup', launch, 'profile:=%s' % profile, 'real_time_factor:=%g' % factor],
+                 ['tb3_sim_bringup', 'tb3_navigation.launch', 'open_rviz:=false', 'map_file:=%s' % map_file],
+                 spawn) as navigation:
         pids = [_node_pid(name) for name in ('/amcl', '/move_base', '/tb3_sim')]
         cpu = [cpu_seconds(pid) for pid in pids]
         wall, sim = time.monotonic(), rospy.get_time()
@@ -265,10 +281,6 @@ def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD
             outcomes.append(outcome)
         wall, sim = time.monotonic() - wall, rospy.get_time() - sim
         used = [cpu_seconds(pid) - before for pid, before in zip(pids, cpu)]
-        navigation.close()
-    finally:
-        for process in reversed(started):
-            process.stop()
     saved = load_map(map_file)
     obstacles = load_world(world, os.path.join(package, 'worlds')).obstacles
     truth = list(navigation.truth)
