@@ -50,6 +50,12 @@ EPSILON = 1e-4  # m/s, rad/s: SimpleTrajectoryGenerator's slack on the velocity 
 ARRIVAL = 0.3
 PASSED = 0.5
 STALLED = 50
+#: Within xy_goal_tolerance, before the approach is over, DWA's samples (each moving at least
+#: min_vel_trans or turning at least min_vel_theta) left the Burger circling 2-4 cm from the goal,
+#: v 0.04 m/s and w 1.4 rad/s, for 3-5 s a goal, and 10 s and more (move_base's oscillation_timeout)
+#: near walls (nav_sim's closed loop and the system tests). There the controller turns in place to
+#: face the goal's position (or to back onto it) to within FACING rad, then drives straight at it.
+FACING = 0.1
 
 
 def _no_sideways(value):
@@ -230,7 +236,11 @@ class DwaController(object):
             command = self._stop_and_rotate(pose, velocity, local, plan[-1][2])
         else:
             self._rotating = False
-            command = self._dwa(pose, velocity, local, plan[-1])
+            command = None
+            if math.hypot(plan[-1][0] - pose[0], plan[-1][1] - pose[1]) <= self.config.xy_goal_tolerance:
+                command = self._last_centimetres(pose, velocity, local, plan[-1])
+            if command is None:
+                command = self._dwa(pose, velocity, local, plan[-1])
         return replace(self._safe(command), followed=local)
 
     def _local_plan(self, pose, plan):
@@ -255,36 +265,63 @@ class DwaController(object):
         w = min(max(w, -config.max_vel_theta), config.max_vel_theta)
         return replace(command, v=float(v), w=float(w))
 
+    def _braking(self, velocity):
+        """(v, w) slowing down as hard as the accelerations allow (a stop at once would ask for more)."""
+        config, period = self.config, self.config.sim_period
+        return (math.copysign(max(0.0, abs(velocity[0]) - config.acc_lim_x * period), velocity[0]),
+                math.copysign(max(0.0, abs(velocity[1]) - config.acc_lim_theta * period), velocity[1]))
+
+    def _turning(self, difference, velocity):
+        """The turn rate in place towards a heading `difference` rad away: between min_vel_theta and
+        max_vel_theta, slow enough to stop in time, within acc_lim_theta of the current turn."""
+        config, period = self.config, self.config.sim_period
+        speed = min(config.max_vel_theta, max(config.min_vel_theta, abs(difference)))
+        speed = min(speed, math.sqrt(2.0 * config.acc_lim_theta * abs(difference)))
+        speed = min(config.max_vel_theta, max(config.min_vel_theta, speed))
+        # The last step turns just what is left: a full period at min_vel_theta would turn
+        # 0.137 rad, most of the yaw tolerance, past the heading.
+        speed = min(speed, abs(difference) / period)
+        reach = config.acc_lim_theta * period
+        return min(max(math.copysign(speed, difference), velocity[1] - reach), velocity[1] + reach)
+
+    def _checked(self, pose, local, v, w):
+        """The Command (v, w) with its trajectory, or None if its footprint would meet an obstacle."""
+        costs, trajectories = self.scorer.score(pose, np.array([[v, w]]), self.scorer.maps(pose, local),
+                                                check_all=True)
+        return None if costs[0] < 0 else Command(v, w, True, trajectories[0])
+
     def _stop_and_rotate(self, pose, velocity, local, goal_yaw):
         config = self.config
-        period = config.sim_period
         difference = normalize_angle(goal_yaw - pose[2])
         if abs(difference) <= ARRIVAL * config.yaw_goal_tolerance:
             self._rotating = False
-            # Brake as hard as acc_lim_theta allows (a stop at once would ask for more).
-            w = math.copysign(max(0.0, abs(velocity[1]) - config.acc_lim_theta * period), velocity[1])
-            return Command(0.0, w, True, pose[None, :])
+            return Command(0.0, self._braking(velocity)[1], True, pose[None, :])
         stopped = abs(velocity[0]) <= config.trans_stopped_vel and abs(velocity[1]) <= config.theta_stopped_vel
         if not self._rotating and not stopped:
-            v = math.copysign(max(0.0, abs(velocity[0]) - config.acc_lim_x * period), velocity[0])
-            w = math.copysign(max(0.0, abs(velocity[1]) - config.acc_lim_theta * period), velocity[1])
-            what = 'stopping'
+            (v, w), what = self._braking(velocity), 'stopping'
         else:
             self._rotating = True
-            speed = min(config.max_vel_theta, max(config.min_vel_theta, abs(difference)))
-            speed = min(speed, math.sqrt(2.0 * config.acc_lim_theta * abs(difference)))
-            speed = min(config.max_vel_theta, max(config.min_vel_theta, speed))
-            # The last step turns just what is left: a full period at min_vel_theta would turn
-            # 0.137 rad, most of the yaw tolerance, past the goal's yaw.
-            speed = min(speed, abs(difference) / period)
-            reach = config.acc_lim_theta * period
-            v, w = 0.0, min(max(math.copysign(speed, difference), velocity[1] - reach), velocity[1] + reach)
-            what = 'rotating'
-        maps = self.scorer.maps(pose, local)
-        costs, trajectories = self.scorer.score(pose, np.array([[v, w]]), maps, check_all=True)
-        if costs[0] < 0:
-            return Command(0.0, 0.0, False, reason='%s would collide' % what)
-        return Command(v, w, True, trajectories[0])
+            v, w, what = 0.0, self._turning(difference, velocity), 'rotating'
+        return self._checked(pose, local, v, w) or Command(0.0, 0.0, False, reason='%s would collide' % what)
+
+    def _last_centimetres(self, pose, velocity, local, goal):
+        """Within xy_goal_tolerance, the approach not over: stop, turn in place to face the goal's
+        position (backwards, if it lies behind and min_vel_x allows), then drive straight at it, the
+        last step just what is left. None (DWA then) if that would meet an obstacle."""
+        config, period = self.config, self.config.sim_period
+        distance = math.hypot(goal[0] - pose[0], goal[1] - pose[1])
+        bearing = normalize_angle(math.atan2(goal[1] - pose[1], goal[0] - pose[0]) - pose[2])
+        backwards = abs(bearing) > math.pi / 2 and config.min_vel_x < 0.0
+        error = normalize_angle(bearing - math.pi) if backwards else bearing
+        if abs(error) > FACING:
+            stopped = abs(velocity[0]) <= config.trans_stopped_vel
+            v, w = (0.0, self._turning(error, velocity)) if stopped else self._braking(velocity)
+        else:
+            reach = config.acc_lim_x * period
+            speed = min(config.min_vel_trans, distance * math.cos(error) / period)
+            v = min(max(-speed if backwards else speed, velocity[0] - reach), velocity[0] + reach)
+            w = self._braking(velocity)[1]
+        return self._checked(pose, local, v, w)
 
     def _dwa(self, pose, velocity, local, goal):
         config = self.config
