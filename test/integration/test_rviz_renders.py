@@ -40,7 +40,7 @@ import yaml
 from geometry_msgs.msg import Twist
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.realpath(__file__)), '..', '..', 'tools'))  # the harness
-from tb3_harness.screen import green_pixels, save_png, screenshot, start_xvfb
+from tb3_harness.screen import green_pixels, save_png, screen_env, screenshot, start_xvfb
 
 from tb3_test_utils import Child, init_test_node, report, wait_for
 
@@ -214,7 +214,7 @@ class RvizRenders(unittest.TestCase):
             rospkg.RosPack().get_path('tb3_sim_bringup'), 'rviz', 'demo.rviz')
         cls.config = RvizConfig(path)
         cls.xvfb, display = start_xvfb(die_with_parent=True)
-        os.environ['DISPLAY'] = display  # rviz inherits it (Child passes the environment on)
+        os.environ.update(screen_env(display))  # rviz inherits it (Child passes the environment on)
         cls.rviz = Child(['rosrun', 'rviz', 'rviz', '-d', path])
         started = time.monotonic()
         frames = []

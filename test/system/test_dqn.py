@@ -27,7 +27,7 @@ import time
 import pytest
 
 from tb3_harness import leftovers
-from tb3_harness.screen import save_png, screenshot, start_xvfb
+from tb3_harness.screen import save_png, screen_env, screenshot, start_xvfb
 
 from tb3_system_utils import Echo, alive, wait_until
 
@@ -97,7 +97,8 @@ def test_the_chapters_commands_train_episode_after_episode_and_end_on_ctrl_c(lau
                                                                               tmp_path):
     xvfb, display = start_xvfb()
     processes.add(xvfb, server=True)
-    monkeypatch.setenv('DISPLAY', display)
+    for name, value in screen_env(display).items():
+        monkeypatch.setenv(name, value)
     world = launches('stage_1', STAGE)
     results = Echo(processes, '/result')
     graphs = launches('result_graph', GRAPHS)

@@ -34,7 +34,7 @@ import yaml
 
 from tb3_harness.map_quality import measure
 from tb3_harness.report import figure
-from tb3_harness.screen import save_png, screenshot, start_xvfb
+from tb3_harness.screen import save_png, screen_env, screenshot, start_xvfb
 from tb3_harness.waypoints import WORLD_LOOP_START
 
 from tb3_system_utils import run, wait_until
@@ -142,7 +142,8 @@ def desktop(processes, tmp_path, monkeypatch):
     xvfb, display = start_xvfb()
     processes.started.append(xvfb)
     monkeypatch.setenv('HOME', str(home))
-    monkeypatch.setenv('DISPLAY', display)
+    for name, value in screen_env(display).items():
+        monkeypatch.setenv(name, value)
     return str(home), display
 
 

@@ -24,7 +24,7 @@ from tb3_harness.mapping import _node_pid
 from tb3_harness.measure import cpu_seconds
 from tb3_harness.processes import Process, start_master, wait_until
 from tb3_harness.report import figure, map_figures
-from tb3_harness.screen import save_png, screenshot, start_xvfb
+from tb3_harness.screen import save_png, screen_env, screenshot, start_xvfb
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 BOXED_IN = os.path.join(HERE, '..', 'data', 'worlds', 'boxed_in.yaml')
@@ -52,7 +52,8 @@ def test_exploration_maps_turtlebot3_world_alone(tmp_path, monkeypatch):
     monkeypatch.setenv('TURTLEBOT3_MODEL', 'burger')
     master = start_master(folder)
     xvfb, display = start_xvfb()
-    monkeypatch.setenv('DISPLAY', display)
+    for name, value in screen_env(display).items():
+        monkeypatch.setenv(name, value)
     pictures = []
 
     def picture():

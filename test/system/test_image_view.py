@@ -4,7 +4,7 @@ shows the pillars of turtlebot3_world that the robot faces at its spawn pose
 (their green, which nothing else on the screen is)."""
 import os
 
-from tb3_harness.screen import green_pixels, save_png, screenshot, start_xvfb
+from tb3_harness.screen import green_pixels, save_png, screen_env, screenshot, start_xvfb
 
 from tb3_system_utils import wait_until
 
@@ -17,7 +17,7 @@ def test_image_view_shows_the_waffle_pis_camera(ros_port, processes, tmp_path):
     xvfb, display = start_xvfb()
     processes.add(xvfb, server=True)
     viewer = processes.start('image_view', ['rosrun', 'image_view', 'image_view', 'image:=/camera/rgb/image_raw'],
-                             env=dict(os.environ, DISPLAY=display))
+                             env=dict(os.environ, **screen_env(display)))
     shots = []
 
     def shown():

@@ -15,7 +15,7 @@ import subprocess
 
 import yaml
 
-from tb3_harness.screen import start_xvfb
+from tb3_harness.screen import screen_env, start_xvfb
 
 from tb3_system_utils import Echo, poses, run, wait_until
 
@@ -123,7 +123,7 @@ def test_the_tutorial_command_by_command(ros_port, processes):
     xvfb, display = start_xvfb()
     processes.add(xvfb, server=True)
     rviz = start(processes, 'rviz', 'rosrun rviz rviz -d `rospack find tb3_sim_bringup`/rviz/demo.rviz',
-                 env=dict(os.environ, DISPLAY=display))
+                 env=dict(os.environ, **screen_env(display)))
 
     # 1. The circle holds after Ctrl+C; the empty Twist stops it.
     circle = start(processes, 'circle', "rostopic pub -r 10 /cmd_vel geometry_msgs/Twist "
@@ -200,7 +200,7 @@ def test_another_model_and_its_camera_in_rviz(ros_port, processes):
     processes.add(xvfb, server=True)
     rviz = start(processes, 'rviz', 'export TURTLEBOT3_MODEL=waffle_pi\n'
                  'rosrun rviz rviz -d `rospack find tb3_sim_bringup`/rviz/camera.rviz',
-                 env=dict(os.environ, DISPLAY=display))
+                 env=dict(os.environ, **screen_env(display)))
     info = echo('/camera/rgb/camera_info')
     assert (info['width'], info['height']) == (640, 480)
     assert wait_until(lambda: re.search(r'Subscribers:\s*\n\s*\* /rviz',

@@ -28,7 +28,7 @@ import rospkg
 
 from tb3_common.map_files import load_map
 from tb3_harness.map_quality import measure
-from tb3_harness.screen import save_png, screenshot, start_xvfb
+from tb3_harness.screen import save_png, screen_env, screenshot, start_xvfb
 from tb3_sim_nav.world_file import load_world
 
 from tb3_system_utils import ROBOTS, wait_until
@@ -228,7 +228,7 @@ def test_robotis_multi_map_merge_merges_the_three_robots_maps(ros_port, processe
     # and the robots' own maps are drawn.
     xvfb, display = start_xvfb()
     processes.add(xvfb, server=True)
-    processes.start('rviz', ['bash', '-c', MULTI_RVIZ], env=_burger(DISPLAY=display))
+    processes.start('rviz', ['bash', '-c', MULTI_RVIZ], env=_burger(**screen_env(display)))
     drawn = []
 
     def maps_drawn():

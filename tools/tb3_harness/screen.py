@@ -3,7 +3,6 @@
 Screenshots come from imagemagick's `import -window root -depth 8 ppm:-`,
 decoded here, so no imaging library is needed.
 """
-import os
 import re
 import subprocess
 import time
@@ -13,8 +12,8 @@ import numpy
 from .processes import Process
 
 SIZE = (1280, 800)
-#: How programs draw on a test's screen, set in this process's environment (which they inherit) by
-#: start_xvfb. Mesa's llvmpipe (bookworm: Mesa 22.3, LLVM 15) crashed rviz at random in its first
+#: How programs draw on a test's screen (screen_env passes it to what a test starts there).
+#: Mesa's llvmpipe (bookworm: Mesa 22.3, LLVM 15) crashed rviz at random in its first
 #: frame, inside LLVM as it compiled a shader (SIGSEGV in llvm::FixedVectorType::get; a few starts
 #: in a hundred on a busy machine; llvm-project#57850 has it in GNOME); softpipe compiles nothing
 #: with LLVM, and the tests see the same views in it (doc/testing.md has the runs).
@@ -22,9 +21,8 @@ RENDERING = {'GALLIUM_DRIVER': 'softpipe'}
 
 
 def start_xvfb(size=SIZE, timeout=20.0, **options):
-    """Xvfb on a display it picks (-displayfd 1 prints the number): (Process, ':N'). Also sets
-    RENDERING in this process's environment. `options` go to Process (die_with_parent...)."""
-    os.environ.update(RENDERING)
+    """Xvfb on a display it picks (-displayfd 1 prints the number): (Process, ':N').
+    `options` go to Process (die_with_parent...)."""
     xvfb = Process('xvfb', ['Xvfb', '-displayfd', '1', '-screen', '0', '%dx%dx24' % size, '-nolisten', 'tcp'],
                    **options)
     deadline = time.monotonic() + timeout
@@ -37,6 +35,13 @@ def start_xvfb(size=SIZE, timeout=20.0, **options):
             xvfb.stop()
             raise RuntimeError('Xvfb did not start: %s' % description)
         time.sleep(0.05)
+
+
+def screen_env(display):
+    """The variables a program started on `display` needs: DISPLAY and RENDERING. Given to each
+    program (or set for one test by monkeypatch), never to this process for good: a simulator
+    started later would render its cameras with softpipe too."""
+    return dict(RENDERING, DISPLAY=display)
 
 
 def read_ppm(data):
