@@ -75,7 +75,7 @@ class Fleet(object):
         """Every output due at the next step, as at start: sim time went back to zero."""
         for io in self.robots.values():
             for sensor in io.sensors:
-                sensor.schedule.restart()
+                sensor.restart()
 
     def apply_commands(self, now_ns):
         for io in self.robots.values():

@@ -50,6 +50,10 @@ class SensorIO(object):
         """`paced`: the simulation keeps to a real-time factor (not as fast as possible)."""
         return self.schedule.due(now_ns) and self.wanted()
 
+    def restart(self):
+        """Due at the next step, as at start (sim time went back to zero)."""
+        self.schedule.restart()
+
     def needs_reading(self):
         return True
 
