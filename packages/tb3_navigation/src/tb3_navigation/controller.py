@@ -232,15 +232,16 @@ class DwaController(object):
         if not len(local):
             return Command(0.0, 0.0, False, reason='no point of the plan within the local costmap')
         self._arrive(pose, plan[-1])
+        maps = self.scorer.maps(pose, local)
         if self.is_position_reached(pose, plan):
-            command = self._stop_and_rotate(pose, velocity, local, plan[-1][2])
+            command = self._stop_and_rotate(pose, velocity, maps, plan[-1][2])
         else:
             self._rotating = False
             command = None
             if math.hypot(plan[-1][0] - pose[0], plan[-1][1] - pose[1]) <= self.config.xy_goal_tolerance:
-                command = self._last_centimetres(pose, velocity, local, plan[-1])
+                command = self._last_centimetres(pose, velocity, maps, plan[-1])
             if command is None:
-                command = self._dwa(pose, velocity, local, plan[-1])
+                command = self._dwa(pose, velocity, maps, plan[-1])
         return replace(self._safe(command), followed=local)
 
     def _local_plan(self, pose, plan):
@@ -284,13 +285,13 @@ class DwaController(object):
         reach = config.acc_lim_theta * period
         return min(max(math.copysign(speed, difference), velocity[1] - reach), velocity[1] + reach)
 
-    def _checked(self, pose, local, v, w):
-        """The Command (v, w) with its trajectory, or None if its footprint would meet an obstacle."""
-        costs, trajectories = self.scorer.score(pose, np.array([[v, w]]), self.scorer.maps(pose, local),
-                                                check_all=True)
+    def _checked(self, pose, maps, v, w):
+        """The Command (v, w) with its trajectory, or None if its footprint would meet an obstacle
+        (`maps`: the scorer's maps for this pose and local plan)."""
+        costs, trajectories = self.scorer.score(pose, np.array([[v, w]]), maps, check_all=True)
         return None if costs[0] < 0 else Command(v, w, True, trajectories[0])
 
-    def _stop_and_rotate(self, pose, velocity, local, goal_yaw):
+    def _stop_and_rotate(self, pose, velocity, maps, goal_yaw):
         config = self.config
         difference = normalize_angle(goal_yaw - pose[2])
         if abs(difference) <= ARRIVAL * config.yaw_goal_tolerance:
@@ -302,9 +303,9 @@ class DwaController(object):
         else:
             self._rotating = True
             v, w, what = 0.0, self._turning(difference, velocity), 'rotating'
-        return self._checked(pose, local, v, w) or Command(0.0, 0.0, False, reason='%s would collide' % what)
+        return self._checked(pose, maps, v, w) or Command(0.0, 0.0, False, reason='%s would collide' % what)
 
-    def _last_centimetres(self, pose, velocity, local, goal):
+    def _last_centimetres(self, pose, velocity, maps, goal):
         """Within xy_goal_tolerance, the approach not over: stop, turn in place to face the goal's
         position (backwards, if it lies behind and min_vel_x allows), then drive straight at it, the
         last step just what is left. None (DWA then) if that would meet an obstacle."""
@@ -321,9 +322,9 @@ class DwaController(object):
             speed = min(config.min_vel_trans, distance * math.cos(error) / period)
             v = min(max(-speed if backwards else speed, velocity[0] - reach), velocity[0] + reach)
             w = self._braking(velocity)[1]
-        return self._checked(pose, local, v, w)
+        return self._checked(pose, maps, v, w)
 
-    def _dwa(self, pose, velocity, local, goal):
+    def _dwa(self, pose, velocity, maps, goal):
         config = self.config
         period = config.sim_period
         low_v = max(config.min_vel_x, velocity[0] - config.acc_lim_x * period)
@@ -340,7 +341,7 @@ class DwaController(object):
         if not len(samples):
             return Command(0.0, 0.0, False, reason='no velocity in the dynamic window')
         far = math.hypot(goal[0] - pose[0], goal[1] - pose[1]) > GOAL_ZONE
-        costs, trajectories = self.scorer.score(pose, samples, self.scorer.maps(pose, local), clearance=far)
+        costs, trajectories = self.scorer.score(pose, samples, maps, clearance=far)
         valid = np.flatnonzero(costs >= 0)
         if not len(valid):
             return Command(0.0, 0.0, False, reason='every trajectory collides or leaves the plan')
