@@ -37,7 +37,12 @@ from .reconfigure import Reconfigure
 
 WARN_PERIOD = 5.0    # s between repeats of the same warning
 IDLE_POLL = 0.01     # wall s between checks while paused or holding
-RESTORED_PARAMETERS = ('/use_sim_time', '/robot_description')  # set again on a new master
+#: rospy asks the master for this parameter at every log message while it is unset (its cache keeps no
+#: missing parameter: rospy/impl/rosout.py, get_param_cached). A node that logs between a tick and its
+#: reaction then waits on the master, which lockstep does not see, and its reaction lands steps late
+#: (doc/design.md). Set to its default, every node caches it at its first message.
+ROSOUT_TOPICS = '/rosout_disable_topics_generation'
+RESTORED_PARAMETERS = ('/use_sim_time', '/robot_description', ROSOUT_TOPICS)  # set again on a new master
 
 
 class SimulatorNode(object):
@@ -227,6 +232,8 @@ def main():
         # that rviz and the shell stay responsive (lockstep waits for the
         # nodes that drive the robot whatever their priority).
         os.nice(10)
+    if config.lockstep and not rospy.has_param(ROSOUT_TOPICS):
+        rospy.set_param(ROSOUT_TOPICS, False)
     restored = dict((name, rospy.get_param(name)) for name in RESTORED_PARAMETERS if rospy.has_param(name))
     try:
         node = SimulatorNode(simulation, restored, life)
