@@ -23,6 +23,7 @@ DEAD_WAIT = 3.0         # wall s without a master
 RECOVER_WITHIN = 10.0   # wall s after the new master answers
 DRIVE = 0.1             # m/s
 DRIVE_WALL = 3.0        # wall s of driving after `rostopic pub -1` returned
+ROSOUT_TOPICS = '/rosout_disable_topics_generation'  # set by the simulator (doc/design.md, lockstep)
 
 
 def topics():
@@ -42,12 +43,17 @@ def ground_truth():
     return position['x'], position['y']
 
 
-def use_sim_time(port):
+def parameter(port, name):
+    """A parameter's value on the master at `port`; None when it is unset or the master does not answer."""
     import rosgraph
     try:
-        return rosgraph.Master('/tb3_system_test', master_uri=master_uri(port)).getParam('/use_sim_time') is True
+        return rosgraph.Master('/tb3_system_test', master_uri=master_uri(port)).getParam(name)
     except Exception:
-        return False
+        return None
+
+
+def use_sim_time(port):
+    return parameter(port, '/use_sim_time') is True
 
 
 def children_of(pid):
@@ -76,6 +82,8 @@ def test_simulator_survives_master_restart_and_new_nodes_drive_it(ros_port, proc
     assert wait_until(lambda: ground_truth() is not None or not sim.running(), SIM_READY) and sim.running(), \
         'the simulator did not publish ground truth; %s' % sim.log
     old_pid = master_pid(port)
+    # Set to its default so that a node's log message does not ask the master (lockstep, doc/design.md).
+    assert parameter(port, ROSOUT_TOPICS) is False
 
     first.stop()
     assert master_pid(port) is None, 'the first master still answers'
@@ -96,6 +104,7 @@ def test_simulator_survives_master_restart_and_new_nodes_drive_it(ros_port, proc
     print('MEASURED master_restart: use_sim_time after %.2f s, /odom listed after %.2f s'
           % (sim_time_after, odom_after))
     assert sim_time_back, '/use_sim_time not true %.0f s after the new master came up' % RECOVER_WITHIN
+    assert parameter(port, ROSOUT_TOPICS) is False, 'the simulator did not set %s again' % ROSOUT_TOPICS
     assert odom_back, '`rostopic list` without /odom %.0f s after the new master came up: %s' % (
         RECOVER_WITHIN, topics())
 
