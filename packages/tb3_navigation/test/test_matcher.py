@@ -49,7 +49,7 @@ def field_of(obstacles, poses, rng):
     for pose in poses:
         sensor = tuple(compose(pose, SENSOR))
         grid_map.add_scan(sensor, ray_cast(obstacles, sensor, rng), MAX_URANGE, RANGE_MAX)
-    return matcher.WallField(grid_map.grid, grid_map.occupied(), SIGMA, grid_map.hit_means())
+    return matcher.WallField.of_map(grid_map.grid, grid_map.occupied(), SIGMA, grid_map.hit_means())
 
 
 def points_at(obstacles, pose, rng):
@@ -118,10 +118,43 @@ def test_along_a_corridor_the_prior_holds_the_pose():
 
 def test_an_empty_map_leaves_the_prior_alone():
     empty = OccupancyGrid.around(0.05, -3.0, -3.0, 3.0, 3.0)
-    field = matcher.WallField(empty.grid, empty.occupied(), SIGMA, empty.hit_means())
+    field = matcher.WallField.of_map(empty.grid, empty.occupied(), SIGMA, empty.hit_means())
     points = points_at(ROOM, (0.0, 0.0, 0.0), np.random.default_rng(8))
     prior = (0.1, 0.2, 0.3)
     assert field.empty
     assert matcher.search(field, points, prior, 0.1, 0.1, 0.05, 0.05) == (prior, 0.0)
     pose, score = matcher.refine(field, points, prior, iterations=5)
     assert pose == pytest.approx(prior) and score == 0.0
+
+
+def test_shapes_kept_up_to_date_scan_by_scan_are_those_of_the_whole_map():
+    """WallShapes refits only the cells near those a scan changed; after each scan its wall points
+    and pairing matrices are those made from the whole map at once, and so are a field's over a
+    box and its matches."""
+    rng = np.random.default_rng(9)
+    grid_map = OccupancyGrid.around(0.05, -3.0, -3.0, 7.0, 3.0)
+    grid_map.take_touched()
+    shapes = matcher.WallShapes(grid_map.grid)
+    for pose in [(-1.0, 0.5, 0.0), (1.0, -0.6, 2.0), (0.0, 0.0, -1.0), (0.5, 0.8, 2.5)]:
+        sensor = tuple(compose(pose, SENSOR))
+        grid_map.add_scan(sensor, ray_cast(ROOM, sensor, rng), MAX_URANGE, RANGE_MAX)
+        cells = grid_map.take_touched()
+        assert 0 < len(cells) < grid_map.hits.size // 4  # a scan changes only the cells it saw
+        shapes.update(cells, grid_map.occupied_at(cells), grid_map.hit_means().reshape(-1, 2)[cells])
+        whole = matcher.WallShapes.of_map(grid_map.grid, grid_map.occupied(), grid_map.hit_means())
+        np.testing.assert_array_equal(shapes.points, whole.points)
+        np.testing.assert_array_equal(shapes.pairing, whole.pairing)
+    assert shapes.has_point(np.flatnonzero(grid_map.occupied())).all()
+    truth = (0.3, -0.2, 0.4)
+    points = points_at(ROOM, truth, np.random.default_rng(4))
+    around = matcher.WallField(shapes, SIGMA, box=(0, grid_map.grid.height, 0, 80))  # x up to 1 m: the room's part
+    everywhere = matcher.WallField(whole, SIGMA)
+    assert around.covers((10, 20, 10, 20)) and not around.covers((10, 20, 70, 90))
+    prior = np.add(truth, (0.05, -0.05, 0.05))
+    inside = points[np.hypot(*matcher.place(prior, points).T - np.array([[-1.0], [0.0]])) < 1.5]
+    assert len(inside) > 30
+    for field in (around, everywhere):
+        pose, _ = matcher.refine(field, inside, prior, iterations=10)
+        assert error(pose, truth)[0] < 0.01
+    assert (matcher.search(around, inside, prior, 0.1, 0.1, 0.05, 0.05)
+            == matcher.search(everywhere, inside, prior, 0.1, 0.1, 0.05, 0.05))

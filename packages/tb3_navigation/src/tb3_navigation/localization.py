@@ -110,7 +110,7 @@ class Amcl(object):
         self.field = LikelihoodField(grid, values, config.laser_likelihood_max_dist)
         self.model = LikelihoodFieldModel(self.field, config.laser_z_hit, config.laser_z_rand, config.laser_sigma_hit)
         occupied = np.asarray(values).reshape(grid.shape) == 100
-        self._walls = (matcher.WallField(grid, occupied, REFINE_SIGMA, matcher.line_means(grid, occupied))
+        self._walls = (matcher.WallField.of_map(grid, occupied, REFINE_SIGMA, matcher.line_means(grid, occupied))
                        if config.refine_estimate and occupied.any() else None)
         self._points = None  # the last update's beam end points (base frame), for the refinement
         free = np.argwhere(np.asarray(values).reshape(grid.shape) == 0)  # amcl samples free cells only, not unknown

@@ -48,44 +48,107 @@ LINE_SPREAD = 0.05
 CORNER_WEIGHT = 0.3
 
 
+class WallShapes(object):
+    """Each occupied cell's wall point (the mean of its hits, else its centre) and pairing matrix (see
+    _pairing) over a whole `grid`, kept up to date cell by cell: a scan added to a map changes a few
+    thousand cells of the grid's 160 000 and the matrices of a few hundred, and remaking all of them at
+    each map update was a third of the SLAM's CPU on the house (doc/speed.md)."""
+
+    def __init__(self, grid):
+        self.grid = grid
+        r = SHAPE_RADIUS
+        # Framed by SHAPE_RADIUS cells of NaN: a cell's neighbourhood is then at hand even at the grid's edge.
+        self.points = np.full((grid.height + 2 * r, grid.width + 2 * r, 2), np.nan)
+        self.pairing = np.zeros((grid.height + 2 * r, grid.width + 2 * r, 2, 2))
+
+    @classmethod
+    def of_map(cls, grid, occupied, means=None):
+        """The shapes of a whole map: `occupied` (bool, the grid's shape), `means` (height, width, 2; NaN
+        where a cell has none) or None (the cells' centres)."""
+        shapes = cls(grid)
+        shapes.update(np.arange(grid.width * grid.height), np.ravel(occupied),
+                      None if means is None else np.reshape(means, (-1, 2)))
+        return shapes
+
+    def _framed(self, cells):
+        r, width = SHAPE_RADIUS, self.grid.width
+        return (cells // width + r) * (width + 2 * r) + cells % width + r
+
+    def update(self, cells, occupied, means=None):
+        """Take the state of the grid's `cells` (flat indices into its shape, each once): whether each
+        is `occupied`, and the mean (k, 2) of the hits in it (NaN: none; None: the centres)."""
+        cells = np.asarray(cells, dtype=np.intp)
+        width = self.grid.width
+        points = self.grid.centres(np.stack((cells % width, cells // width), axis=-1))
+        if means is not None:
+            points = np.where(np.isnan(means), points, means)
+        points[~np.asarray(occupied, dtype=bool)] = np.nan
+        framed = self._framed(cells)
+        flat = self.points.reshape(-1, 2)
+        old = flat[framed]
+        changed = np.any((points != old) & ~(np.isnan(points) & np.isnan(old)), axis=-1)
+        if not changed.any():
+            return
+        flat[framed[changed]] = points[changed]
+        # The cells whose neighbourhood holds a changed cell: their lines are fitted anew.
+        r, stride = SHAPE_RADIUS, width + 2 * SHAPE_RADIUS
+        offsets = (np.arange(-r, r + 1)[:, None] * stride + np.arange(-r, r + 1)[None, :]).ravel()
+        near = np.unique((framed[changed][:, None] + offsets[None, :]).ravel())
+        near = near[(near >= 0) & (near < len(flat))]
+        pairing = self.pairing.reshape(-1, 2, 2)
+        pairing[near] = 0.0
+        near = near[~np.isnan(flat[near, 0])]
+        pairing[near] = _pairing(self.points, near // stride, near % stride)
+
+    def has_point(self, cells):
+        """Whether each of the grid's `cells` (flat indices) has a wall point (was occupied at the last update)."""
+        return ~np.isnan(self.points.reshape(-1, 2)[self._framed(np.asarray(cells, dtype=np.intp)), 0])
+
+
 class WallField(object):
-    """The map as the matcher reads it: the likelihood field of `occupied` (bool, the grid's shape) on
-    `grid` for `sigma` (m), and the walls to pair points with: each occupied cell's point `means`
-    (height, width, 2) in the frame (NaN, or None for all: the cell's centre) and the wall's
-    direction there.
+    """The map as the matcher reads it, from `shapes` (a WallShapes): the likelihood field of the
+    occupied cells for `sigma` (m), and the walls to pair points with, over the grid's cells in `box`
+    (row0, row1, col0, col1; None: around every occupied cell).
 
     Unlike amcl's field (tb3_navigation.likelihood: made once per map, over
-    the whole grid), this one is made anew as the map grows, a few times a
-    second: so it is only computed over the box around the occupied cells
-    widened by 4 sigma (and one more cell), where the field is below exp(-8)
-    and taken as 0, which a ring of zeros around the box gives; and it keeps
-    each cell's nearest occupied cell, to pair points with.
+    the whole grid), the SLAM's is made anew as the map grows, a few times a
+    second: so it is only computed over the box where the scans can land
+    (see slam.Slam), widened by 4 sigma (and one more cell), where the field
+    is below exp(-8) and taken as 0, which a ring of zeros around the box
+    gives; and it keeps each cell's nearest occupied cell, to pair points with.
     """
 
-    def __init__(self, grid, occupied, sigma, means=None):
-        self.grid, self.sigma = grid, float(sigma)
-        rows, cols = np.nonzero(occupied)
-        self.empty = rows.size == 0
+    def __init__(self, shapes, sigma, box=None):
+        self.grid, self.sigma, self._shapes = shapes.grid, float(sigma), shapes
+        grid, r = shapes.grid, SHAPE_RADIUS
+        pad = int(math.ceil(4.0 * sigma / grid.resolution)) + 1
+        if box is None:
+            rows, cols = np.nonzero(~np.isnan(shapes.points[r:-r, r:-r, 0]))
+            box = (rows.min(), rows.max() + 1, cols.min(), cols.max() + 1) if rows.size else (0, 0, 0, 0)
+        self.box = box
+        self.row0, self.col0 = max(0, box[0] - pad), max(0, box[2] - pad)
+        row1, col1 = min(grid.height, box[1] + pad), min(grid.width, box[3] + pad)
+        window = ~np.isnan(shapes.points[self.row0 + r:row1 + r, self.col0 + r:col1 + r, 0])
+        self.empty = row1 <= self.row0 or col1 <= self.col0 or not window.any()
+        self._rings = {}  # the field framed by rings of zeros of each width asked for (coarse_scores)
         if self.empty:
             self.row0 = self.col0 = 0
             self._padded = np.zeros((3, 3))
             return
-        pad = int(math.ceil(4.0 * sigma / grid.resolution)) + 1
-        self.row0, self.col0 = max(0, rows.min() - pad), max(0, cols.min() - pad)
-        row1, col1 = min(grid.height, rows.max() + pad + 1), min(grid.width, cols.max() + pad + 1)
-        window = occupied[self.row0:row1, self.col0:col1]
         distance, nearest = ndimage.distance_transform_edt(~window, return_indices=True)
         self._padded = np.pad(np.exp(-0.5 * (distance * grid.resolution / sigma) ** 2), 1)
-        # The wall point and the pairing matrix of every window cell's nearest occupied cell.
-        rows, cols = np.mgrid[self.row0:row1, self.col0:col1]
-        points = grid.centres(np.stack((cols, rows), axis=-1))
-        if means is not None:
-            own = means[self.row0:row1, self.col0:col1]
-            points = np.where(np.isnan(own), points, own)
-        points = np.where(window[..., None], points, np.nan)
-        pairing = _pairing(points)
-        self._wall = points[nearest[0], nearest[1]]
-        self._pairing = pairing[nearest[0], nearest[1]]
+        # Each window cell's nearest occupied cell, as a flat index into the shapes' (framed) arrays.
+        self._nearest = (nearest[0] + self.row0 + r) * (grid.width + 2 * r) + nearest[1] + self.col0 + r
+
+    @classmethod
+    def of_map(cls, grid, occupied, sigma, means=None):
+        """The field of a whole map: `occupied` (bool, the grid's shape) and `means` as WallShapes.of_map's."""
+        return cls(WallShapes.of_map(grid, occupied, means), sigma)
+
+    def covers(self, box):
+        """Whether the field was made over the whole of `box` (row0, row1, col0, col1)."""
+        return (self.box[0] <= box[0] and box[1] <= self.box[1] and self.box[2] <= box[2]
+                and box[3] <= self.box[3])
 
     @property
     def values(self):
@@ -117,26 +180,48 @@ class WallField(object):
         """For points (n, 2): the wall point (n, 2) each is paired with, the pairing matrix (n, 2, 2)
         that turns the offset from it into the residual (the wall's normal in its first row, and
         nothing more along a wall; a weighted identity at a corner), and whether it has one (n,)."""
-        cells = self.grid.to_cells(points) - (self.col0, self.row0)
-        height, width = self._padded.shape[0] - 2, self._padded.shape[1] - 2
-        inside = (cells[:, 0] >= 0) & (cells[:, 0] < width) & (cells[:, 1] >= 0) & (cells[:, 1] < height)
-        if self.empty or not inside.any():
+        if self.empty:
             return np.zeros_like(points), np.zeros((len(points), 2, 2)), np.zeros(len(points), dtype=bool)
-        col, row = np.clip(cells[:, 0], 0, width - 1), np.clip(cells[:, 1], 0, height - 1)
-        return self._wall[row, col], self._pairing[row, col], inside
+        cells = self.grid.to_cells(points) - (self.col0, self.row0)
+        height, width = self._nearest.shape
+        inside = (cells[:, 0] >= 0) & (cells[:, 0] < width) & (cells[:, 1] >= 0) & (cells[:, 1] < height)
+        index = self._nearest[np.clip(cells[:, 1], 0, height - 1), np.clip(cells[:, 0], 0, width - 1)]
+        return (self._shapes.points.reshape(-1, 2)[index], self._shapes.pairing.reshape(-1, 2, 2)[index],
+                inside)
 
     def score(self, points):
         """Sum of the field under points (..., n, 2): about how many of them lie on the map's walls."""
         return self.value(points).sum(axis=-1)
 
-    def coarse_score(self, points):
-        """score() with each point read at its cell's centre, not between centres: a quarter of
-        the work, for the correlative search, whose steps are a cell long anyway."""
+    def coarse_scores(self, points, shifts):
+        """score() of points (..., n, 2) moved by each of `shifts` (s, 2) m, with each point read at
+        its cell's centre, not between centres: (..., s). For the correlative search, whose steps are
+        a cell long anyway. Shifts of whole cells move the points' flat indices, not the points, on
+        the field framed by a ring of zeros twice as wide as the longest shift (a point off the
+        window, clipped onto the ring's inner half, stays on the ring however it is shifted): half
+        the time of placing each shifted point anew (doc/speed.md)."""
+        moves = self.grid.to_cells_float(shifts) - self.grid.to_cells_float(np.zeros(2))  # (s, 2) in cells
+        whole = np.rint(moves)
+        if not np.all(np.abs(moves - whole) < 1e-9):  # steps that are not whole cells: one point at a time
+            return self.score_cells(np.floor(self.grid.to_cells_float(points)[..., None, :, :] + moves[:, None, :]))
+        reach = int(np.abs(whole).max()) if len(whole) else 0
+        ring = 2 * reach + 1
+        framed = self._rings.get(ring)
+        if framed is None:
+            framed = self._rings[ring] = np.pad(self.values, ring)
+        height, width = framed.shape
         cells = np.floor(self.grid.to_cells_float(points)).astype(np.intp)
+        col = np.clip(cells[..., 0] + ring - self.col0, reach, width - 1 - reach)
+        row = np.clip(cells[..., 1] + ring - self.row0, reach, height - 1 - reach)
+        offsets = (whole[:, 1] * width + whole[:, 0]).astype(np.intp)
+        return framed.ravel()[(row * width + col)[..., None, :] + offsets[:, None]].sum(axis=-1)
+
+    def score_cells(self, cells):
+        """The field summed over the last axis at the centres of cells (..., n, 2) (ix, iy, whole numbers)."""
         height, width = self._padded.shape
-        col = np.clip(cells[..., 0] + 1 - self.col0, 0, width - 1)
-        row = np.clip(cells[..., 1] + 1 - self.row0, 0, height - 1)
-        return self._padded[row, col].sum(axis=-1)
+        col = np.clip(cells[..., 0].astype(np.intp) + 1 - self.col0, 0, width - 1)
+        row = np.clip(cells[..., 1].astype(np.intp) + 1 - self.row0, 0, height - 1)
+        return self._padded.ravel()[row * width + col].sum(axis=-1)
 
 
 def place(pose, points):
@@ -158,8 +243,7 @@ def search(field, points, prior, linear, angular, lstep, astep):
     turned = np.stack((cos * points[:, 0] - sin * points[:, 1] + prior[0],
                        sin * points[:, 0] + cos * points[:, 1] + prior[1]), axis=-1)
     shifts = np.stack(np.meshgrid(offsets, offsets, indexing='ij'), axis=-1).reshape(-1, 2)
-    # (yaws, shifts, n, 2) -> scores (yaws, shifts)
-    scores = field.coarse_score(turned[:, None, :, :] + shifts[None, :, None, :])
+    scores = field.coarse_scores(turned, shifts)  # (yaws, shifts)
     # Ties (as on an empty map) go to the pose nearest the prior, not to the first one listed.
     nearness = (np.abs(yaws - prior[2])[:, None] / max(astep, 1e-9)
                 + np.abs(shifts).sum(axis=1)[None, :] / max(lstep, 1e-9))
@@ -178,39 +262,42 @@ def refine(field, points, pose, iterations, prior=None, prior_weight=0.0, reach=
     heading with a lever of 1 m): it holds the pose where no wall does, as along a corridor,
     and barely moves it where a few hundred points agree. `prior_weight` may also be a (3, 3)
     information matrix on (x, y, yaw) in the same units (points' worth), to pull more in some
-    directions than in others. Returns the pose and its score."""
+    directions than in others. Returns the pose and its score.
+
+    Each step solves the 3 x 3 normal equations, summed from the residuals' two rows by hand:
+    a least-squares solver on the stacked (2n + 3, 3) rows took 4 times as long."""
     reach = 3.0 * field.sigma if reach is None else reach
     pose = np.array(pose, dtype=float)
-    root = None
+    information = None
     if prior is not None:
         weight = np.asarray(prior_weight, dtype=float)
-        root = (math.sqrt(max(float(weight), 0.0)) * np.eye(3) if weight.ndim == 0
-                else np.linalg.cholesky(weight).T)  # root.T @ root == the information
-        if not root.any():
-            root = None
+        information = max(float(weight), 0.0) * np.eye(3) if weight.ndim == 0 else weight
+        if not information.any():
+            information = None
+    px, py = points[:, 0], points[:, 1]
     for _ in range(iterations):
         cos, sin = math.cos(pose[2]), math.sin(pose[2])
-        turned = np.stack((cos * points[:, 0] - sin * points[:, 1], sin * points[:, 0] + cos * points[:, 1]), axis=-1)
-        world = turned + pose[:2]
+        tx, ty = cos * px - sin * py, sin * px + cos * py  # the points turned, not moved
+        world = np.stack((tx + pose[0], ty + pose[1]), axis=-1)
         wall, pairing, paired = field.walls(world)
         offset = world - wall
-        use = paired & (np.hypot(offset[:, 0], offset[:, 1]) < reach)
+        use = paired & (np.einsum('ni,ni->n', offset, offset) < reach * reach)
         if use.sum() < 3:
             break
-        pairing, offset, turned = pairing[use], offset[use], turned[use]
-        residual = np.einsum('nij,nj->ni', pairing, offset)
-        # d(point)/d(x, y, yaw) = [[1, 0, -y], [0, 1, x]] with (x, y) the point turned, not moved.
-        moving = np.zeros((len(turned), 2, 3))
-        moving[:, 0, 0] = moving[:, 1, 1] = 1.0
-        moving[:, 0, 2], moving[:, 1, 2] = -turned[:, 1], turned[:, 0]
-        jacobian = np.einsum('nij,njk->nik', pairing, moving)
-        weight = np.sqrt(1.0 / (1.0 + np.sum(residual ** 2, axis=1) / field.sigma ** 2))[:, None]
-        rows, values = (jacobian * weight[:, :, None]).reshape(-1, 3), -(residual * weight).ravel()
-        if root is not None:
+        (a, b), (c, d) = pairing[use, 0].T, pairing[use, 1].T
+        ox, oy, tx, ty = offset[use, 0], offset[use, 1], tx[use], ty[use]
+        # The residual's two rows (pairing . offset) and their derivatives by (x, y, yaw): d(point) =
+        # [[1, 0, -ty], [0, 1, tx]].
+        rows = np.stack((a, b, b * tx - a * ty, a * ox + b * oy, c, d, d * tx - c * ty, c * ox + d * oy))
+        # Cauchy weights on the squared residual: w = 1 / (1 + r^2 / sigma^2).
+        w = 1.0 / (1.0 + (rows[3] ** 2 + rows[7] ** 2) / field.sigma ** 2)
+        first, second = rows[:4] * np.sqrt(w), rows[4:] * np.sqrt(w)
+        normal = first.dot(first.T) + second.dot(second.T)  # (4, 4): [J^T W J, J^T W r; ., .]
+        hessian, gradient = normal[:3, :3], -normal[:3, 3]
+        if information is not None:
             towards = np.array((prior[0] - pose[0], prior[1] - pose[1], normalize_angle(prior[2] - pose[2])))
-            rows = np.vstack((rows, root))
-            values = np.concatenate((values, root.dot(towards)))
-        step = np.linalg.lstsq(rows, values, rcond=1e-6)[0]
+            hessian, gradient = hessian + information, gradient + information.dot(towards)
+        step = np.linalg.lstsq(hessian, gradient, rcond=1e-12)[0]
         # One pairing is only good nearby: no step longer than a cell or a twentieth of a radian.
         step /= max(1.0, math.hypot(step[0], step[1]) / field.grid.resolution, abs(step[2]) / 0.05)
         pose += step
@@ -219,18 +306,13 @@ def refine(field, points, pose, iterations, prior=None, prior_weight=0.0, reach=
     pose[2] = normalize_angle(pose[2])
     return tuple(pose), float(field.score(place(pose, points)))
 
-
-def _pairing(points):
-    """The pairing matrix (height, width, 2, 2) of each cell with a wall point in `points`
-    (height, width, 2; NaN elsewhere): [[nx, ny], [0, 0]] with n the normal of the line the
-    wall points within SHAPE_RADIUS cells lie on, or CORNER_WEIGHT times the identity where
+def _pairing(points, rows, cols):
+    """The pairing matrices (cells, 2, 2) of the cells (`rows`, `cols`) of `points` (a WallShapes'
+    framed array of wall points, NaN where none): [[nx, ny], [0, 0]] with n the normal of the line
+    the wall points within SHAPE_RADIUS cells lie on, or CORNER_WEIGHT times the identity where
     they do not lie on one."""
-    height, width = points.shape[:2]
-    pairing = np.zeros((height, width, 2, 2))
-    rows, cols = np.nonzero(~np.isnan(points[..., 0]))
     r = SHAPE_RADIUS
-    padded = np.pad(points, ((r, r), (r, r), (0, 0)), constant_values=np.nan)
-    around = np.stack([padded[rows + r + dy, cols + r + dx] for dy in range(-r, r + 1) for dx in range(-r, r + 1)],
+    around = np.stack([points[rows + dy, cols + dx] for dy in range(-r, r + 1) for dx in range(-r, r + 1)],
                       axis=1)  # (cells, (2r+1)^2, 2)
     valid = ~np.isnan(around[..., 0])
     count = valid.sum(axis=1)
@@ -245,9 +327,7 @@ def _pairing(points):
     cell = np.zeros((len(rows), 2, 2))
     cell[:, 0, 0], cell[:, 0, 1] = -np.sin(along), np.cos(along)
     cell[~line] = CORNER_WEIGHT * np.eye(2)
-    pairing[rows, cols] = cell
-    return pairing
-
+    return cell
 
 def line_means(grid, occupied, radius=3, flatness=0.1):
     """Wall points for a map that keeps no hits (one loaded from a file): each occupied cell's

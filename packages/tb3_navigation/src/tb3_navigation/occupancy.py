@@ -41,6 +41,7 @@ class OccupancyGrid(object):
         self._point_sum = np.zeros(grid.shape + (2,))
         self._point_count = np.zeros(grid.shape)
         self._means = np.full(grid.shape + (2,), np.nan)
+        self._touched = []  # the cells (flat indices) each scan added since take_touched() counted or hit
         self.scans = 0  # how many scans were added
 
     @classmethod
@@ -54,6 +55,7 @@ class OccupancyGrid(object):
         self._point_sum[:] = 0.0
         self._point_count[:] = 0.0
         self._means[:] = np.nan
+        self._touched = [np.arange(self.hits.size)]
         self.scans = 0
 
     def add_scan(self, sensor_pose, scan, max_urange, max_range=math.inf):
@@ -69,6 +71,7 @@ class OccupancyGrid(object):
         occupied = raytrace.end_cells(self.grid, ends[hit])
         seen = np.union1d(raytrace.crossed_cells(self.grid, sensor_pose[:2], ends), occupied)
         self.visits.flat[seen] += 1
+        self._touched.append(seen)
         self.hits.flat[occupied] += 1
         cells = self.grid.to_cells(ends[hit])
         inside = self.grid.inside(cells)
@@ -87,6 +90,17 @@ class OccupancyGrid(object):
     def occupied(self, occ_thresh=OCC_THRESH):
         """True where more than `occ_thresh` of the scans that saw a cell hit it."""
         return self.hits > occ_thresh * self.visits
+
+    def take_touched(self):
+        """The cells (flat indices, each once) whose counts changed since the last call (after clear():
+        all), and forget them: where the map's state may differ now."""
+        touched = np.unique(np.concatenate(self._touched)) if self._touched else np.zeros(0, dtype=np.intp)
+        self._touched = []
+        return touched
+
+    def occupied_at(self, cells, occ_thresh=OCC_THRESH):
+        """occupied() at `cells` (flat indices)."""
+        return self.hits.flat[cells] > occ_thresh * self.visits.flat[cells]
 
     def hit_means(self):
         """The mean (height, width, 2) of the end points that fell in each cell, NaN in a cell none
