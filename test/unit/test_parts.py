@@ -1,7 +1,10 @@
 """tb3_harness.parts: make test's parts run side by side within their slots, in the plan's order,
 each failing on its exit status or on what it left running, with the lines that say why."""
+import os
+import signal
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -116,3 +119,38 @@ def test_a_real_run_side_by_side_fails_on_status_and_leftovers_and_says_why(tmp_
     tail = done.stdout[done.stdout.index('== why bad failed'):]
     assert 'E       AssertionError: broken on purpose' in tail
     assert tail.rstrip().endswith('FAILED: bad leaver') or tail.rstrip().endswith('FAILED: leaver bad')
+
+
+def test_a_second_sigterm_while_the_parts_stop_leaves_none_running(tmp_path):
+    """CI stops make test with SIGTERM and may send it again: the parts still running are stopped
+    all the same, each as Ctrl+C would (each here takes a second to end on SIGINT)."""
+    slow = tmp_path / 'slow.py'
+    slow.write_text('import os, sys, time\nopen(sys.argv[1], "w").write(str(os.getpid()))\n'
+                    'try:\n    time.sleep(60)\nexcept KeyboardInterrupt:\n    time.sleep(1)\n')
+    plan = tmp_path / 'plan'
+    plan.write_text(''.join('1 slow%d python3 %s %s\n' % (index, slow, tmp_path / ('pid%d' % index))
+                            for index in range(2)))
+    runner = subprocess.Popen([sys.executable, '-m', 'tb3_harness.parts', str(plan), str(tmp_path / 'logs')],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    pids = []
+    try:
+        deadline = time.monotonic() + 20
+        while len(pids) < 2 and time.monotonic() < deadline:
+            time.sleep(0.1)
+            pids = [int(path.read_text()) for path in tmp_path.glob('pid*') if path.read_text()]
+        assert len(pids) == 2, 'the parts did not start'
+        runner.send_signal(signal.SIGTERM)
+        time.sleep(0.5)   # the first part is ending on its SIGINT
+        runner.send_signal(signal.SIGTERM)
+        output = runner.communicate(timeout=30)[0]
+        print(output)
+        assert runner.returncode == 130 and 'INTERRUPTED' in output
+        assert [pid for pid in pids if os.path.exists('/proc/%d' % pid)] == []
+    finally:
+        if runner.poll() is None:
+            runner.kill()
+        for pid in pids:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass

@@ -208,10 +208,18 @@ class Runner(object):
                 for part, took in ended:
                     self._finish(part, took)
         finally:
-            for part in [part for part in self.schedule.running if part.name in self.started]:
-                self.started[part.name][0].stop()   # interrupted: stopped as Ctrl+C would
-                self.schedule.ended(part)
-                self._finish(part, time.monotonic() - self.started[part.name][1])
+            # Interrupted: each part still running is stopped as Ctrl+C would. A second Ctrl+C or
+            # SIGTERM meanwhile (a CI runner's stop repeats it) would end this loop and leave the
+            # parts not yet stopped running on their own: they are ignored until every part is.
+            previous = dict((sig, signal.signal(sig, signal.SIG_IGN)) for sig in (signal.SIGINT, signal.SIGTERM))
+            try:
+                for part in [part for part in self.schedule.running if part.name in self.started]:
+                    self.started[part.name][0].stop()
+                    self.schedule.ended(part)
+                    self._finish(part, time.monotonic() - self.started[part.name][1])
+            finally:
+                for sig, handler in previous.items():
+                    signal.signal(sig, handler)
         return self.results
 
 
