@@ -192,10 +192,22 @@ def test_static_transform_publisher_refuses_bad_arguments_and_ends_at_once(ros_p
     assert took < 2.0
 
 
+def _world_up(timeout=60.0):
+    """Wait, as a learner waits for the world to come up before the next command, until /clock is
+    published: /use_sim_time is set then. A node started before it is set keeps wall time for good
+    (rospy reads the parameter once): move_base did so once beside make test's other parts, and held
+    still, taking every tf stamped in sim time for 1.8e9 s old."""
+    import rosgraph
+    master = rosgraph.Master('/test_real_node_names')
+    assert wait_until(lambda: ['/clock', 'rosgraph_msgs/Clock'] in master.getPublishedTopics('/'), timeout), \
+        'no /clock: the world did not come up'
+
+
 def test_fake_localization_drives_move_base_to_a_goal(ros_port, processes, tmp_path):
     processes.start_master('roscore', ros_port)
     sim = processes.start('sim', ['roslaunch', 'tb3_sim_bringup', 'tb3_world.launch', 'real_time_factor:=0'],
                           env=_burger())
+    _world_up()
     nav = processes.start('nav', ['roslaunch', _launch_file(tmp_path, 'fake_nav.launch', FAKE_LOCALIZATION_LAUNCH)],
                           env=_burger())
     outcome = _probe(processes, 'probe_goal', 'goal', *WORLD_GOAL, timeout=240.0)
@@ -216,6 +228,7 @@ def test_robotis_multi_map_merge_merges_the_three_robots_maps(ros_port, processe
     folder = str(tmp_path)
     # The e-manual's commands, each in a terminal of its own (+ real_time_factor:=0, ours).
     processes.start('sim', MULTI_WORLD.split() + ['real_time_factor:=0'], env=_burger())
+    _world_up()
     for name in ROBOTS:
         processes.start('slam_' + name, MULTI_SLAM[name].split(), env=_burger())
     import rosgraph
