@@ -93,8 +93,7 @@ class WallShapes(object):
         # The cells whose neighbourhood holds a changed cell: their lines are fitted anew.
         r, stride = SHAPE_RADIUS, width + 2 * SHAPE_RADIUS
         offsets = (np.arange(-r, r + 1)[:, None] * stride + np.arange(-r, r + 1)[None, :]).ravel()
-        near = np.unique((framed[changed][:, None] + offsets[None, :]).ravel())
-        near = near[(near >= 0) & (near < len(flat))]
+        near = np.unique((framed[changed][:, None] + offsets[None, :]).ravel())  # inside: the frame holds them
         pairing = self.pairing.reshape(-1, 2, 2)
         pairing[near] = 0.0
         near = near[~np.isnan(flat[near, 0])]
@@ -203,7 +202,7 @@ class WallField(object):
         moves = self.grid.to_cells_float(shifts) - self.grid.to_cells_float(np.zeros(2))  # (s, 2) in cells
         whole = np.rint(moves)
         if not np.all(np.abs(moves - whole) < 1e-9):  # steps that are not whole cells: one point at a time
-            return self.score_cells(np.floor(self.grid.to_cells_float(points)[..., None, :, :] + moves[:, None, :]))
+            return self._score_cells(np.floor(self.grid.to_cells_float(points)[..., None, :, :] + moves[:, None, :]))
         reach = int(np.abs(whole).max()) if len(whole) else 0
         ring = 2 * reach + 1
         framed = self._rings.get(ring)
@@ -216,7 +215,7 @@ class WallField(object):
         offsets = (whole[:, 1] * width + whole[:, 0]).astype(np.intp)
         return framed.ravel()[(row * width + col)[..., None, :] + offsets[:, None]].sum(axis=-1)
 
-    def score_cells(self, cells):
+    def _score_cells(self, cells):
         """The field summed over the last axis at the centres of cells (..., n, 2) (ix, iy, whole numbers)."""
         height, width = self._padded.shape
         col = np.clip(cells[..., 0].astype(np.intp) + 1 - self.col0, 0, width - 1)
