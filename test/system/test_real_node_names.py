@@ -280,3 +280,31 @@ def test_robotis_multi_map_merge_merges_the_three_robots_maps(ros_port, processe
         known[inside] = merged.values[cells[inside][:, 1], cells[inside][:, 0]] >= 0
         print('MEASURED %s: %d known cells, %.1f %% known in the merged map' % (name, len(centres), 100 * known.mean()))
         assert len(centres) > 1000 and known.mean() >= KNOWN_IN_MERGED
+
+
+def test_a_node_started_before_the_world_says_it_keeps_wall_time(ros_port, processes):
+    """The race _world_up avoids, as a learner may meet it: move_base started on a bare roscore, then the
+    world's launch. It cannot switch to sim time; it must say why it will hold still, and how to fix it.
+    A node started after the world (on sim time) must not say so."""
+    import rosgraph
+    processes.start_master('roscore', ros_port)
+    master = rosgraph.Master('/test_real_node_names')
+    early = processes.start('early', ['rosrun', 'move_base', 'move_base'], env=_burger())
+    assert wait_until(lambda: _registered(master, '/move_base'), 60.0), early.output()
+    processes.start('sim', ['roslaunch', 'tb3_sim_bringup', 'tb3_empty_world.launch'], env=_burger())
+    _world_up()
+    assert wait_until(lambda: 'started before /use_sim_time was set' in early.output(None), 30.0), early.output()
+    late = processes.start('late', ['rosrun', 'fake_localization', 'fake_localization'], env=_burger())
+    assert wait_until(lambda: _registered(master, '/fake_localization'), 60.0), late.output()
+    subscribers = dict(master.getSystemState()[1])
+    assert '/fake_localization' in subscribers.get('/clock', ()), 'the late node is not on sim time'
+    time.sleep(2.0)  # /clock at 100 Hz has reached it 200 times meanwhile
+    assert 'use_sim_time' not in late.output(None), late.output()
+
+
+def _registered(master, name):
+    try:
+        master.lookupNode(name)
+        return True
+    except Exception:  # not yet
+        return False

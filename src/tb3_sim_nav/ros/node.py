@@ -225,7 +225,7 @@ def _start_up():
 
 
 def main():
-    life = lifecycle.init_node('tb3_sim')
+    life = lifecycle.init_node('tb3_sim', watch_clock=False)  # it publishes /clock
     config, simulation = _start_up()
     if config.real_time_factor == 0.0:
         # As fast as possible, but only on CPU that no other node wants, so

@@ -144,11 +144,12 @@ class Life(object):
             time.sleep(PARENT_POLL)
 
 
-def init_node(name, **keywords):
+def init_node(name, watch_clock=True, **keywords):
     """rospy.init_node(name, ...) with the ends above wired: the node's Life.
 
     Call from the main thread, as rospy.init_node; handlers installed before it
-    registers, so that no signal finds rospy's own."""
+    registers, so that no signal finds rospy's own. `watch_clock`: see
+    warn_when_left_on_wall_time (the simulator, which publishes /clock, says False)."""
     life = Life()
     life.handle_signals()
     rospy.init_node(name, disable_signals=True, **keywords)
@@ -156,4 +157,35 @@ def init_node(name, **keywords):
     parent = os.getppid()
     if started_by_launcher(parent):
         threading.Thread(target=life._watch_parent, args=(parent,), name='parent_watch', daemon=True).start()
+    if watch_clock:
+        warn_when_left_on_wall_time()
     return life
+
+
+def warn_when_left_on_wall_time():
+    """rospy reads /use_sim_time once, in init_node: a node started before a simulator's launch set it
+    keeps wall time for good, takes every transform stamped in sim time for 1.8e9 s old and, as
+    move_base does then, may hold still without saying why. On wall time, the first /clock message
+    (a simulator runs) makes the node say so once, with the remedy; then it stops listening."""
+    if not rospy.rostime.is_wallclock():
+        return
+    from rosgraph_msgs.msg import Clock
+    heard = threading.Event()
+
+    def on_clock(_message):
+        if heard.is_set():
+            return
+        heard.set()
+        try:
+            late = bool(rospy.get_param('/use_sim_time', False))
+        except Exception:  # the master is away: the remedy is the same
+            late = True
+        why = ('started before /use_sim_time was set (a simulator\'s launch sets it)' if late else
+               'runs on wall time: /use_sim_time is not true')
+        rospy.logwarn('%s %s, while /clock gives sim time: every transform and message stamped in sim time looks '
+                      'about 1.8e9 s old to it. Start it again now that the simulator runs (or set use_sim_time '
+                      'to true in its launch file)', rospy.get_name(), why)
+    subscriber = rospy.Subscriber('/clock', Clock, on_clock, queue_size=1)
+    # Stop listening once heard (a thread, not the callback: it may run before `subscriber` is bound).
+    threading.Thread(target=lambda: heard.wait() and subscriber.unregister(), name='wall_time_check',
+                     daemon=True).start()
