@@ -14,8 +14,11 @@ GMAPPING = ('minimumScore', 'sigma', 'kernelSize', 'lstep', 'astep', 'iterations
             'srr', 'srt', 'str', 'stt', 'linearUpdate', 'angularUpdate', 'temporalUpdate', 'resampleThreshold',
             'particles', 'xmin', 'ymin', 'xmax', 'ymax', 'delta', 'occ_thresh', 'llsamplerange', 'llsamplestep',
             'lasamplerange', 'lasamplestep', 'maxRange', 'maxUrange')
-#: Ours, beside gmapping's: the matcher's reach and pull, jumps, turtlebot3_slam's method.
-OURS = {'odom_weight', 'search_linear', 'search_angular', 'jump_distance', 'jump_angle', 'slam_methods'}
+#: Ours, beside gmapping's: the matcher's reach and pull, jumps, turtlebot3_slam's method; loop closure's,
+#: the first four under slam_toolbox's names.
+OURS = {'odom_weight', 'search_linear', 'search_angular', 'jump_distance', 'jump_angle', 'slam_methods',
+        'do_loop_closing', 'loop_search_maximum_distance', 'loop_match_minimum_chain_size',
+        'loop_match_minimum_response_fine', 'loop_search_linear', 'loop_search_angular'}
 
 
 def names(config_class):

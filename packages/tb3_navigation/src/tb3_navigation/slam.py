@@ -12,10 +12,13 @@ Why one pose and no particle filter: with 100 particles gmapping matches
 each scan 100 times; here one match costs a few ms of numpy, so one
 hypothesis keeps the CPU per scan far below the 200 ms between the
 Burger's scans, and the result depends on nothing but the input (no
-random numbers). The price is no loop closure: a pose that drifted while
-the map grew stays in the map. A 3 m usable range in rooms of at most
-5 m keeps walls already mapped in view nearly all the time, so the drift
-stays small (see the tests' figures for turtlebot3_world and the house).
+random numbers). A 3 m usable range in rooms of at most 5 m keeps walls
+already mapped in view nearly all the time, so the pose does not wander
+(see the tests' figures for turtlebot3_world and the house). Where no
+wall is in range (the house's yard) the pose drifts with the odometry;
+the scans added to the map are then the nodes of a pose graph, and a
+scan that comes back near old ones closes the loop: the poses since are
+corrected and the map drawn anew (tb3_navigation.loop_closure).
 
 Every scan is matched, not only those added to the map: odometry then only
 has to bridge 0.2 s, and the pose the node publishes is corrected at 5 Hz.
@@ -46,6 +49,7 @@ from tb3_common.params import Checked, fail, non_negative, number, parameter, po
 from tb3_common.pose2d import IDENTITY, compose, inverse, relative
 
 from . import matcher
+from .loop_closure import LoopCloser, Node
 from .occupancy import OccupancyGrid
 
 #: After an odometry jump the prediction is only as good as the odometry's drift since the map last
@@ -98,6 +102,19 @@ class SlamConfig(Checked):
                                      positive, 'm')
     jump_angle: float = parameter(1.0, 'rad, likewise (the Burger turns at most 2.84 rad/s: 0.57 rad in 0.2 s)',
                                   positive, 'rad')
+    # Loop closure (tb3_navigation.loop_closure), under slam_toolbox's names where they mean the same.
+    do_loop_closing: bool = parameter(True, 'match a scan that comes back near old ones against them and correct '
+                                            'the poses since and the map')
+    loop_search_maximum_distance: float = parameter(3.0, 'm: old scans this near the pose are matched against',
+                                                    positive, 'm')
+    loop_match_minimum_chain_size: int = parameter(10, 'old scans (0.2 m of driving apart) needed near the pose',
+                                                   number(1))
+    loop_match_minimum_response_fine: float = parameter(
+        0.6, "a closing match's least score per end point (1: every point on an old wall)",
+        number(0.0, 1.0, low_open=True))
+    loop_search_linear: float = parameter(0.5, "m: the closing match's search reach around the pose",
+                                          non_negative, 'm')
+    loop_search_angular: float = parameter(0.3, 'rad: its reach in heading', non_negative, 'rad')
 
     def check_together(self):
         if self.maxRange and self.maxRange < self.maxUrange:
@@ -137,6 +154,7 @@ class Slam(object):
         self._shapes, self._shapes_version = matcher.WallShapes(self.map.grid), 0
         self._touched = np.zeros(0, dtype=np.intp)  # the map's cells changed since the shapes took them
         self._field = None
+        self.loops = LoopCloser(self.config, self.map.grid)
 
     def update(self, stamp, odom_pose, scan, sensor_pose=IDENTITY):
         """Take one scan (a tb3_navigation.scan.Scan) at `stamp` (s), with `odom_pose` (x, y, yaw)
@@ -162,12 +180,26 @@ class Slam(object):
         if self.matched:
             self.map_to_odom = tuple(compose(pose, inverse(odom)))
         self.pose, self._odom = pose, odom
-        if self._due(stamp) and self.map.add_scan(tuple(compose(pose, sensor_pose)), scan, c.maxUrange,
-                                                  c.maxRange or scan.range_max):
+        max_range = c.maxRange or scan.range_max
+        if self._due(stamp) and self.map.add_scan(tuple(compose(pose, sensor_pose)), scan, c.maxUrange, max_range):
             # A scan with no usable beam is not counted: the next one is due as well.
             self.map_updates += 1
             self._last_added, self._moved, self._turned = stamp, 0.0, 0.0
-        return pose
+            closed = self.loops.add(pose, points, Node(scan, sensor_pose, c.maxUrange, max_range, odom),
+                                    lambda: self.map.occupied(c.occ_thresh), self.jumped)
+            if closed is not None:
+                self._closed(closed)
+        return self.pose
+
+    def _closed(self, pose):
+        """A loop closed: the pose is `pose`, the map drawn anew from every scan at its corrected pose."""
+        self.pose = pose
+        self.map_to_odom = tuple(compose(pose, inverse(self._odom)))
+        self.loops.redraw(self.map)
+        self.map.take_touched()
+        self._shapes, self._touched, self._field = matcher.WallShapes(self.map.grid), np.zeros(0, dtype=np.intp), None
+        self._shapes.update(np.arange(self.map.grid.width * self.map.grid.height),
+                            self.map.occupied(self.config.occ_thresh).ravel(), self.map.hit_means().reshape(-1, 2))
 
     def _match(self, points, priors, widen=1):
         """The best match of `points` (base frame) from any of `priors`, or None if none scores

@@ -1,0 +1,185 @@
+"""Loop closure for the SLAM (tb3_navigation.slam), as Karto's and slam_toolbox's: the scans added to the
+map are the nodes of a pose graph; one that comes back near scans taken long ago is matched against a
+map of those alone, and a good match ties the two together. No ROS here.
+
+Why: the SLAM matches each scan against the map it has built. Where no wall is in range (the house's
+yard: 3 m of usable range) its pose drifts with the odometry, and what it draws meanwhile is drawn
+drifted; when old walls come back in range, the pose snaps back onto them over a few scans. The map
+keeps the drifted walls, a second time (doc/design.md).
+
+So the chain of the graph does not take the SLAM's step between two scans when it snapped (differs by
+more than SNAP from the odometry's step, which knows no walls): it takes the odometry's. The chain
+then still holds the drift, and a closure, which says where the robot really came back, disagrees
+with it: the graph spreads the correction over the poses since the loop began, and the map is drawn
+anew from every scan at its corrected pose.
+"""
+import math
+from collections import namedtuple
+
+import numpy as np
+
+from tb3_common.pose2d import compose, normalize_angle, relative
+
+from . import matcher
+from .occupancy import OccupancyGrid
+from .pose_graph import PoseGraph
+
+#: Information (inverse covariance) of a constraint between two scans in a row, and of a loop closure:
+#: 2 cm and 0.6 degree. The same for both, so that a closure's correction is spread evenly along the
+#: chain of scans it closes.
+INFORMATION = np.diag([1.0 / 0.02 ** 2, 1.0 / 0.02 ** 2, 1.0 / 0.01 ** 2])
+#: The SLAM's step between two scans added to the map (about 0.5 s apart) that differs this much (m, rad)
+#: from the odometry's is taken for a snap back onto old walls: the chain takes the odometry's step.
+#: (Its steps while the SLAM holds the pose by walls differ by a few mm.)
+SNAP = (0.02, 0.01)
+#: A closing match must score this much more per point than the pose as it is: along a corridor, where
+#: a slide scores the same, a match is no evidence.
+CLEARER = 0.05
+#: m driven between two searches for a loop (a search costs a few tens of ms).
+SEARCH_EVERY = 0.5
+#: A scan is old enough to close a loop with when the robot has driven this many times
+#: loop_search_maximum_distance since it: it left that place and came back.
+LEFT_AND_BACK = 2.0
+#: The old scans of the map a scan is matched against: at most this many, at least SPACING m of
+#: driving apart (a robot standing still adds the same scan again and again).
+SUBMAP_SCANS = 15
+SPACING = 0.2
+#: A closing match this near the pose (m, rad) agrees with it; a graph whose constraints all hold this
+#: well is not worth optimising and redrawing the map for.
+NEGLIGIBLE = (0.025, 0.01)
+
+#: One scan of the graph: the scan, the scanner's pose in the base frame, the map's range limits for it,
+#: the odometry's pose of the base when it was taken.
+Node = namedtuple('Node', 'scan sensor_pose max_urange max_range odom')
+
+
+class LoopCloser(object):
+    """The pose graph of the scans added to a map, and the search for loops among them. `config` is
+    the SLAM's (tb3_navigation.slam.SlamConfig)."""
+
+    def __init__(self, config, grid):
+        """`grid`: the map's (tb3_common.grid.Grid)."""
+        self.config = config
+        self._grid = grid
+        self.graph = PoseGraph()
+        self._nodes = []
+        self._travelled = []  # m driven, along the chain of scans, to each scan
+        self._searched_at = -math.inf  # m driven at the last search
+        self.closures = 0  # loops closed that moved the poses
+
+    def add(self, pose, points, node, walls, jumped=False):
+        """Adds the scan just added to the map at `pose`, `points` its end points (base frame);
+        `walls` (a tb3_navigation.occupancy.OccupancyGrid's occupied(), or a callable giving it) is the
+        map's; `jumped`: the odometry jumped before the scan (its step is then no measure). Returns the
+        pose corrected by a loop closure (and then redraws nothing: see redraw), or None."""
+        index = self.graph.add_pose(pose)
+        self._nodes.append(node)
+        if index == 0:
+            self._travelled.append(0.0)
+            return None
+        c = self.config
+        previous = self.graph.poses[index - 1]
+        front = relative(previous, pose)
+        # The odometry's step when the SLAM's differs from it by more than SNAP: a snap back onto old walls.
+        step = front if jumped else relative(self._nodes[index - 1].odom, node.odom)
+        snapped = _differ(front, step, SNAP)
+        self._travelled.append(self._travelled[-1] + math.hypot(pose[0] - previous[0], pose[1] - previous[1]))
+        due = snapped or self._travelled[-1] - self._searched_at >= SEARCH_EVERY
+        closure = self._match_old(index, points, walls) if c.do_loop_closing and due else None
+        if due and not snapped:
+            self._searched_at = self._travelled[-1]
+        # A snap back onto old walls stays out of the chain: closures say where the robot came back.
+        self.graph.add_edge(index - 1, index, step if snapped else front, INFORMATION)
+        if closure is None:
+            return None
+        old, matched = closure
+        self.graph.add_edge(old, index, relative(self.graph.poses[old], matched), INFORMATION)
+        if not _differ(np.abs(self.graph.errors()).max(axis=0), (0.0, 0.0, 0.0), NEGLIGIBLE):
+            return None
+        self.graph.optimize()
+        self.closures += 1
+        return tuple(self.graph.poses[index])
+
+    def _field_of(self, indices, pose, search):
+        """The likelihood field of the scans `indices` at their poses, around `pose` (None if empty)."""
+        c = self.config
+        reach = c.maxUrange + search + 0.5
+        submap = OccupancyGrid.around(c.delta, pose[0] - reach, pose[1] - reach, pose[0] + reach, pose[1] + reach)
+        for i in indices:
+            self._draw(submap, i)
+        field = matcher.WallField.of_map(submap.grid, submap.occupied(c.occ_thresh), c.sigma, submap.hit_means())
+        return None if field.empty else field
+
+    def _old_scans_near(self, index, walls):
+        """Indices of the old scans (see LEFT_AND_BACK) within loop_search_maximum_distance of scan
+        `index` and in its sight (no wall of the map between: scans of a wall's other face would pull
+        the pose by the wall's thickness), nearest first, SPACING apart, at most SUBMAP_SCANS."""
+        c = self.config
+        travelled = np.array(self._travelled)
+        poses = self.graph.poses
+        distance = np.hypot(*(poses[:index, :2] - poses[index, :2]).T)
+        old = np.flatnonzero((travelled[index] - travelled[:index] > LEFT_AND_BACK * c.loop_search_maximum_distance)
+                             & (distance < c.loop_search_maximum_distance))
+        old = old[in_sight(self._grid, walls, poses[index, :2], poses[old, :2])]
+        chosen, bins = [], set()
+        for candidate in old[np.argsort(distance[old], kind='stable')]:
+            spot = int(travelled[candidate] // SPACING)
+            if spot not in bins:
+                bins.add(spot)
+                chosen.append(candidate)
+            if len(chosen) == SUBMAP_SCANS:
+                break
+        return chosen
+
+    def _match_old(self, index, points, walls):
+        """(old scan, pose) of scan `index` matched against the old scans near it, or None: the match
+        must agree with the pose (within NEGLIGIBLE) or score CLEARER than it (along a corridor a
+        slide scores the same)."""
+        c = self.config
+        old = self._old_scans_near(index, walls() if callable(walls) else walls)
+        if len(old) < c.loop_match_minimum_chain_size:
+            return None
+        pose = tuple(self.graph.poses[index])
+        field = self._field_of(old, pose, c.loop_search_linear)
+        if field is None:
+            return None
+        start, _ = matcher.search(field, points, pose, c.loop_search_linear, c.loop_search_angular, c.lstep, c.astep)
+        matched, score = matcher.refine(field, points, start, 2 * c.iterations)
+        if score < c.loop_match_minimum_response_fine * len(points):
+            return None
+        gain = score - field.score(matcher.place(pose, points))
+        if _differ(matched, pose, NEGLIGIBLE) and gain < CLEARER * len(points):
+            return None
+        return old[0], matched
+
+    def _draw(self, grid, index):
+        node = self._nodes[index]
+        grid.add_scan(tuple(compose(self.graph.poses[index], node.sensor_pose)), node.scan, node.max_urange,
+                      node.max_range)
+
+    def redraw(self, grid):
+        """Draws `grid` (an OccupancyGrid) anew from every scan at its pose in the graph."""
+        grid.clear()
+        for index in range(len(self._nodes)):
+            self._draw(grid, index)
+
+
+def _differ(a, b, limits):
+    """Whether poses (or differences) `a` and `b` are farther apart than `limits` (m, rad)."""
+    return math.hypot(a[0] - b[0], a[1] - b[1]) > limits[0] or abs(normalize_angle(a[2] - b[2])) > limits[1]
+
+
+def in_sight(grid, walls, origin, targets, step=0.25):
+    """Whether each of `targets` (n, 2) is seen from `origin` (x, y): no cell of `walls` (bool, the
+    grid's shape) on the segment between, sampled every `step` of a cell, their own cells left out."""
+    targets = np.asarray(targets, dtype=float).reshape(-1, 2)
+    start = grid.to_cells_float(np.asarray(origin, dtype=float))
+    span = grid.to_cells_float(targets) - start
+    samples = max(2, int(np.ceil(np.hypot(span[:, 0], span[:, 1]).max(initial=0.0) / step)))
+    fractions = np.linspace(0.0, 1.0, samples)[1:-1]
+    ix = np.floor(start[0] + span[:, 0:1] * fractions).astype(np.intp)
+    iy = np.floor(start[1] + span[:, 1:2] * fractions).astype(np.intp)
+    inside = (ix >= 0) & (ix < grid.width) & (iy >= 0) & (iy < grid.height)
+    blocked = np.zeros(ix.shape, dtype=bool)
+    blocked[inside] = walls[iy[inside], ix[inside]]
+    return ~blocked.any(axis=1)
