@@ -3,7 +3,7 @@ import os
 
 import pytest
 
-from tb3_system_utils import MASTER_TIMEOUT, Processes, harness, master_uri, wait_until
+from tb3_system_utils import MASTER_TIMEOUT, Processes, harness, master_uri, registered, wait_until
 
 
 @pytest.fixture
@@ -42,7 +42,7 @@ def module_master(tmp_path_factory):
             import rosgraph
             server = rosgraph.Master('/tb3_test')
             # roscore sets its parameters and starts rosout after its master answers.
-            assert wait_until(lambda: server.hasParam('/run_id') and _registered(server, '/rosout'), MASTER_TIMEOUT), \
+            assert wait_until(lambda: server.hasParam('/run_id') and registered(server, '/rosout'), MASTER_TIMEOUT), \
                 'roscore -p %d: no /run_id or /rosout within %.0f s' % (port, MASTER_TIMEOUT)
             yield port, set(server.getParamNames())
         finally:
@@ -63,11 +63,3 @@ def shared_master(module_master):
         if server.hasParam(name):   # gone with a namespace deleted before it
             server.deleteParam(name)
     return port
-
-
-def _registered(server, node):
-    try:
-        server.lookupNode(node)
-        return True
-    except Exception:  # rosgraph.MasterError: not (yet) registered
-        return False

@@ -39,6 +39,15 @@ def alive(pid):
         return False
 
 
+def registered(master, node):
+    """True once `node` is registered with `master` (a rosgraph.Master)."""
+    try:
+        master.lookupNode(node)
+        return True
+    except Exception:  # rosgraph.MasterError: not (yet) registered
+        return False
+
+
 def wait_until(predicate, timeout, poll=0.2):
     """Poll until `predicate()` is true or `timeout` wall s pass; its last value."""
     deadline = time.monotonic() + timeout

@@ -31,7 +31,7 @@ from tb3_harness.map_quality import measure
 from tb3_harness.screen import save_png, screen_env, screenshot, start_xvfb
 from tb3_sim_nav.world_file import load_world
 
-from tb3_system_utils import ROBOTS, wait_until
+from tb3_system_utils import ROBOTS, registered, wait_until
 
 
 def _burger(**variables):
@@ -290,21 +290,13 @@ def test_a_node_started_before_the_world_says_it_keeps_wall_time(ros_port, proce
     processes.start_master('roscore', ros_port)
     master = rosgraph.Master('/test_real_node_names')
     early = processes.start('early', ['rosrun', 'move_base', 'move_base'], env=_burger())
-    assert wait_until(lambda: _registered(master, '/move_base'), 60.0), early.output()
+    assert wait_until(lambda: registered(master, '/move_base'), 60.0), early.output()
     processes.start('sim', ['roslaunch', 'tb3_sim_bringup', 'tb3_empty_world.launch'], env=_burger())
     _world_up()
     assert wait_until(lambda: 'started before /use_sim_time was set' in early.output(None), 30.0), early.output()
     late = processes.start('late', ['rosrun', 'fake_localization', 'fake_localization'], env=_burger())
-    assert wait_until(lambda: _registered(master, '/fake_localization'), 60.0), late.output()
+    assert wait_until(lambda: registered(master, '/fake_localization'), 60.0), late.output()
     subscribers = dict(master.getSystemState()[1])
     assert '/fake_localization' in subscribers.get('/clock', ()), 'the late node is not on sim time'
     time.sleep(2.0)  # /clock at 100 Hz has reached it 200 times meanwhile
     assert 'use_sim_time' not in late.output(None), late.output()
-
-
-def _registered(master, name):
-    try:
-        master.lookupNode(name)
-        return True
-    except Exception:  # not yet
-        return False

@@ -48,9 +48,9 @@ SPACING = 0.2
 #: well is not worth optimising and redrawing the map for.
 NEGLIGIBLE = (0.025, 0.01)
 
-#: One scan of the graph: the scan, the scanner's pose in the base frame, the map's range limits for it,
-#: the odometry's pose of the base when it was taken.
-Node = namedtuple('Node', 'scan sensor_pose max_urange max_range odom')
+#: One scan of the graph: the scan, the scanner's pose in the base frame, the range beyond which its hits
+#: are dropped (maxRange or its range_max), the odometry's pose of the base when it was taken.
+Node = namedtuple('Node', 'scan sensor_pose max_range odom')
 
 
 class LoopCloser(object):
@@ -69,9 +69,9 @@ class LoopCloser(object):
 
     def add(self, pose, points, node, walls, jumped=False):
         """Adds the scan just added to the map at `pose`, `points` its end points (base frame);
-        `walls` (a tb3_navigation.occupancy.OccupancyGrid's occupied(), or a callable giving it) is the
-        map's; `jumped`: the odometry jumped before the scan (its step is then no measure). Returns the
-        pose corrected by a loop closure (and then redraws nothing: see redraw), or None."""
+        `walls()` gives the map's occupied cells (called only when a loop is searched for); `jumped`: the
+        odometry jumped before the scan (its step is then no measure). Returns the pose corrected by a
+        loop closure (and then redraws nothing: see redraw), or None."""
         index = self.graph.add_pose(pose)
         self._nodes.append(node)
         if index == 0:
@@ -136,7 +136,7 @@ class LoopCloser(object):
         must agree with the pose (within NEGLIGIBLE) or score CLEARER than it (along a corridor a
         slide scores the same)."""
         c = self.config
-        old = self._old_scans_near(index, walls() if callable(walls) else walls)
+        old = self._old_scans_near(index, walls())
         if len(old) < c.loop_match_minimum_chain_size:
             return None
         pose = tuple(self.graph.poses[index])
@@ -154,7 +154,7 @@ class LoopCloser(object):
 
     def _draw(self, grid, index):
         node = self._nodes[index]
-        grid.add_scan(tuple(compose(self.graph.poses[index], node.sensor_pose)), node.scan, node.max_urange,
+        grid.add_scan(tuple(compose(self.graph.poses[index], node.sensor_pose)), node.scan, self.config.maxUrange,
                       node.max_range)
 
     def redraw(self, grid):

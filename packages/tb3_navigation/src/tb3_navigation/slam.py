@@ -185,7 +185,7 @@ class Slam(object):
             # A scan with no usable beam is not counted: the next one is due as well.
             self.map_updates += 1
             self._last_added, self._moved, self._turned = stamp, 0.0, 0.0
-            closed = self.loops.add(pose, points, Node(scan, sensor_pose, c.maxUrange, max_range, odom),
+            closed = self.loops.add(pose, points, Node(scan, sensor_pose, max_range, odom),
                                     lambda: self.map.occupied(c.occ_thresh), self.jumped)
             if closed is not None:
                 self._closed(closed)
@@ -197,9 +197,9 @@ class Slam(object):
         self.map_to_odom = tuple(compose(pose, inverse(self._odom)))
         self.loops.redraw(self.map)
         self.map.take_touched()
-        self._shapes, self._touched, self._field = matcher.WallShapes(self.map.grid), np.zeros(0, dtype=np.intp), None
-        self._shapes.update(np.arange(self.map.grid.width * self.map.grid.height),
-                            self.map.occupied(self.config.occ_thresh).ravel(), self.map.hit_means().reshape(-1, 2))
+        self._shapes = matcher.WallShapes.of_map(self.map.grid, self.map.occupied(self.config.occ_thresh),
+                                                 self.map.hit_means())
+        self._touched, self._field = np.zeros(0, dtype=np.intp), None
 
     def _match(self, points, priors, widen=1):
         """The best match of `points` (base frame) from any of `priors`, or None if none scores
