@@ -55,7 +55,7 @@ class SlamNode(object):
                       self.odom_frame, self.base_frame, self.transform_publish_period)
         self.slam = Slam(self.config)
         self.frames = Frames(self.name)
-        self._lock = threading.Lock()  # the core, between the scan callback and the tf timer and service
+        self._lock = threading.Lock()  # the core, between the scan callback and the map service
         self._sensors = {}  # scan frame -> its pose in the base frame (static: asked once)
         self._scans = 0  # scans heard, for throttle_scans
         self._last_stamp = None
@@ -109,8 +109,10 @@ class SlamNode(object):
             self._send_map_to_odom()
 
     def _send_map_to_odom(self):
-        with self._lock:
-            correction = self.slam.map_to_odom
+        # Not under the lock: the core replaces map_to_odom whole (one tuple), and a scan's update holds the
+        # lock for as long as it takes (a loop closure's redraw of the map: seconds), in which map -> odom
+        # must go on being sent, or every lookup through the map frame fails meanwhile.
+        correction = self.slam.map_to_odom
         self.frames.send(self.map_frame, self.odom_frame, correction,
                          rospy.Time.now() + rospy.Duration(self.tf_delay))
 
