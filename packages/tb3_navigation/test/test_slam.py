@@ -13,8 +13,9 @@ from tb3_common.pose2d import IDENTITY, compose, normalize_angle, relative
 from tb3_harness import ROOT as REPO
 from tb3_harness.drives import HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, path_length, record_drive
 from tb3_harness.map_quality import measure
+from tb3_navigation.occupancy import OccupancyGrid
 from tb3_navigation.scan import Scan
-from tb3_navigation.slam import Slam, SlamConfig
+from tb3_navigation.slam import REDRAW_PER_SCAN, Slam, SlamConfig
 from tb3_sim_nav.world_file import load_world
 
 #: turtlebot3_slam's gmapping_params.yaml (ROBOTIS-GIT/turtlebot3, noetic), the values we share.
@@ -143,6 +144,35 @@ def test_a_loop_closed_after_a_blind_stretch_corrects_the_drift_and_the_map(loop
     # (A third of the world was never seen: its surface is not covered.)
     assert after.occupied_near_surface > 0.99 and after.doubled_wall_share < 0.005, after.summary()
     assert after.occupied_near_surface > before.occupied_near_surface + 0.1
+
+
+def test_a_closures_redraw_is_spread_over_the_scans_after_it_and_ends_as_one_at_once(loop):
+    """The map after a closure is drawn anew REDRAW_PER_SCAN scans of the graph at a time (all at once
+    took 2 s of CPU in one scan's update on a drive round the house): at the end it is the map every
+    scan of the graph draws at its pose, and meanwhile the pose follows the odometry, matched by nothing."""
+    ranges = loop.ranges.copy()
+    ranges[150:300] = np.inf
+    slam, drawn, unmatched = Slam(), [], []
+    draw, update = slam.loops.draw, slam.update
+
+    def counted_draw(grid, indices):
+        drawn.append(len(indices))
+        draw(grid, indices)
+
+    def watched_update(*args):
+        redrawing = slam._redraw is not None
+        pose = update(*args)
+        if redrawing:
+            unmatched.append(not slam.matched)
+        return pose
+    slam.loops.draw, slam.update = counted_draw, watched_update
+    run(loop, ranges=ranges, slam=slam)
+    assert slam.loops.closures >= 1 and len(drawn) > slam.loops.closures  # spread: more than one draw a closure
+    assert max(drawn) <= REDRAW_PER_SCAN and unmatched and all(unmatched)
+    assert slam._redraw is None  # done before the drive's end
+    whole = OccupancyGrid(slam.grid)
+    draw(whole, range(len(slam.loops.graph)))
+    assert np.array_equal(whole.hits, slam.map.hits) and np.array_equal(whole.visits, slam.map.visits)
 
 
 def test_without_a_blind_stretch_no_loop_moves_anything(loop_slam):

@@ -67,11 +67,12 @@ class LoopCloser(object):
         self._searched_at = -math.inf  # m driven at the last search
         self.closures = 0  # loops closed that moved the poses
 
-    def add(self, pose, points, node, walls, jumped=False):
+    def add(self, pose, points, node, walls, jumped=False, search=True):
         """Adds the scan just added to the map at `pose`, `points` its end points (base frame);
         `walls()` gives the map's occupied cells (called only when a loop is searched for); `jumped`: the
-        odometry jumped before the scan (its step is then no measure). Returns the pose corrected by a
-        loop closure (and then redraws nothing: see redraw), or None."""
+        odometry jumped before the scan (its step is then no measure); `search`: False while the map is
+        being drawn anew (its walls are not where the graph now puts them). Returns the pose corrected by
+        a loop closure (and then draws nothing: see draw), or None."""
         index = self.graph.add_pose(pose)
         self._nodes.append(node)
         if index == 0:
@@ -85,7 +86,7 @@ class LoopCloser(object):
         snapped = _differ(front, step, SNAP)
         self._travelled.append(self._travelled[-1] + math.hypot(pose[0] - previous[0], pose[1] - previous[1]))
         due = snapped or self._travelled[-1] - self._searched_at >= SEARCH_EVERY
-        closure = self._match_old(index, points, walls) if c.do_loop_closing and due else None
+        closure = self._match_old(index, points, walls) if c.do_loop_closing and search and due else None
         if due and not snapped:
             self._searched_at = self._travelled[-1]
         # A snap back onto old walls stays out of the chain: closures say where the robot came back.
@@ -157,10 +158,9 @@ class LoopCloser(object):
         grid.add_scan(tuple(compose(self.graph.poses[index], node.sensor_pose)), node.scan, self.config.maxUrange,
                       node.max_range)
 
-    def redraw(self, grid):
-        """Draws `grid` (an OccupancyGrid) anew from every scan at its pose in the graph."""
-        grid.clear()
-        for index in range(len(self._nodes)):
+    def draw(self, grid, indices):
+        """Draws the scans `indices` into `grid` (an OccupancyGrid) at their poses in the graph."""
+        for index in indices:
             self._draw(grid, index)
 
 

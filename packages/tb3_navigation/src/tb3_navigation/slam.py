@@ -58,6 +58,11 @@ JUMP_SEARCH = 3
 #: m the likelihood field reaches beyond where a scan can land: the robot may drive that far before it
 #: is made anew (at 0.22 m/s, 2 s of driving when the map does not change).
 FIELD_SLACK = 0.5
+#: After a loop closure the map is drawn anew from every scan of the graph, this many at each scan that
+#: comes in: all at once, the 700 scans of a drive round the house took 1.5 s of CPU in one scan's
+#: update, and a simulator in lockstep waits 0.5 s at most (doc/speed.md). Meanwhile the pose follows the
+#: odometry (the old map's walls lie where the drift drew them): 14 scans, 2.8 s, on that drive.
+REDRAW_PER_SCAN = 50
 
 
 @dataclasses.dataclass(frozen=True)
@@ -146,7 +151,8 @@ class Slam(object):
         self.score = 0.0  # the last match's score (0: no match)
         self.matched = False  # whether the last scan's match was used
         self.jumped = False  # whether the odometry jumped before the last scan
-        self.map_updates = 0  # how many scans the map holds; it changes when this does
+        self.map_updates = 0  # changes whenever the map does: a scan added, the map drawn anew
+        self._redraw = None  # after a loop closure: [the map being drawn anew, how many scans it holds]
         self._odom = None
         self._last_added = None
         self._moved = self._turned = 0.0
@@ -171,9 +177,12 @@ class Slam(object):
         if self.pose is not None:
             motion = relative(self._odom, odom)
             self.jumped = bool(math.hypot(motion[0], motion[1]) > c.jump_distance or abs(motion[2]) > c.jump_angle)
-            # After a jump, the pose before it is the other hypothesis: the odometry was reset in place.
-            priors = [predicted, self.pose] if self.jumped else [predicted]
-            pose = self._match(points, priors, widen=JUMP_SEARCH if self.jumped else 1) or predicted
+            if self._redraw is not None and self.jumped:
+                self._go_on_drawing(everything=True)  # a jump's two hypotheses are told apart by the map
+            if self._redraw is None:
+                # After a jump, the pose before it is the other hypothesis: the odometry was reset in place.
+                priors = [predicted, self.pose] if self.jumped else [predicted]
+                pose = self._match(points, priors, widen=JUMP_SEARCH if self.jumped else 1) or predicted
             step = relative(self.pose, pose)
             self._moved += math.hypot(step[0], step[1])
             self._turned += abs(step[2])
@@ -186,20 +195,38 @@ class Slam(object):
             self.map_updates += 1
             self._last_added, self._moved, self._turned = stamp, 0.0, 0.0
             closed = self.loops.add(pose, points, Node(scan, sensor_pose, max_range, odom),
-                                    lambda: self.map.occupied(c.occ_thresh), self.jumped)
+                                    lambda: self.map.occupied(c.occ_thresh), self.jumped, search=self._redraw is None)
             if closed is not None:
                 self._closed(closed)
+                return self.pose
+        if self._redraw is not None:
+            self._go_on_drawing()
         return self.pose
 
     def _closed(self, pose):
-        """A loop closed: the pose is `pose`, the map drawn anew from every scan at its corrected pose."""
+        """A loop closed: the pose is `pose`; the map is drawn anew from every scan at its corrected pose,
+        starting now (see REDRAW_PER_SCAN)."""
         self.pose = pose
         self.map_to_odom = tuple(compose(pose, inverse(self._odom)))
-        self.loops.redraw(self.map)
+        self._redraw = [OccupancyGrid(self.map.grid), 0]
+        self._go_on_drawing()
+
+    def _go_on_drawing(self, everything=False):
+        """Draws the next REDRAW_PER_SCAN scans of the graph (or all the rest) into the new map; the last
+        of them puts it in the old one's place."""
+        grid, drawn = self._redraw
+        end = len(self.loops.graph) if everything else min(drawn + REDRAW_PER_SCAN, len(self.loops.graph))
+        self.loops.draw(grid, range(drawn, end))
+        self._redraw[1] = end
+        if end < len(self.loops.graph):
+            return
+        self.map, self._redraw = grid, None
         self.map.take_touched()
         self._shapes = matcher.WallShapes.of_map(self.map.grid, self.map.occupied(self.config.occ_thresh),
                                                  self.map.hit_means())
         self._touched, self._field = np.zeros(0, dtype=np.intp), None
+        self.map_updates += 1
+        self._shapes_version = self.map_updates
 
     def _match(self, points, priors, widen=1):
         """The best match of `points` (base frame) from any of `priors`, or None if none scores
