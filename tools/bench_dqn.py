@@ -105,7 +105,7 @@ def table(rows, passed, totals, evaluations, args):
     lines = ['turtlebot3_dqn stage 1 from scratch (seed 0, factor 0), %s' % datetime.date.today().isoformat(),
              'machine: %s' % machine(), '',
              '| | |', '|---|---|',
-             '| sim s per wall s while training | %.1fx |' % (train_sim / max(train_wall, 1e-9)),
+             '| sim s per wall s while training | %.2fx |' % (train_sim / max(train_wall, 1e-9)),  # 9.98 is not 10
              '| episodes trained | %d |' % (rows[-1][0] if rows else 0),
              '| greedy policy reaches the goal in >= %d %% of %d episodes | %s |'
              % (round(args.target * 100), evaluations,
