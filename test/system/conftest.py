@@ -3,6 +3,8 @@ import os
 
 import pytest
 
+from tb3_harness.screen import screen_env, start_xvfb
+
 from tb3_system_utils import MASTER_TIMEOUT, Processes, harness, master_uri, registered, wait_until
 
 
@@ -23,6 +25,17 @@ def processes(tmp_path):
         yield started
     finally:
         started.stop_all()
+
+
+@pytest.fixture
+def screen(processes, monkeypatch):
+    """A screen of the test's own (Xvfb), with this process's (so its children's) DISPLAY set to it, as
+    on a desktop where the launches open rviz: its display."""
+    xvfb, display = start_xvfb()
+    processes.add(xvfb, server=True)
+    for name, value in screen_env(display).items():
+        monkeypatch.setenv(name, value)
+    return display
 
 
 @pytest.fixture(scope='module')

@@ -27,7 +27,7 @@ import time
 import pytest
 
 from tb3_harness import leftovers
-from tb3_harness.screen import save_png, screen_env, screenshot, start_xvfb
+from tb3_harness.screen import save_png, screenshot
 
 from tb3_system_utils import Echo, alive, wait_until
 
@@ -93,12 +93,8 @@ def pure(image, channel):
     return int(((image[..., channel] > 200) & (others[0] < 60) & (others[1] < 60)).sum())
 
 
-def test_the_chapters_commands_train_episode_after_episode_and_end_on_ctrl_c(launches, processes, monkeypatch,
-                                                                              tmp_path):
-    xvfb, display = start_xvfb()
-    processes.add(xvfb, server=True)
-    for name, value in screen_env(display).items():
-        monkeypatch.setenv(name, value)
+def test_the_chapters_commands_train_episode_after_episode_and_end_on_ctrl_c(launches, processes, screen, tmp_path):
+    display = screen
     world = launches('stage_1', STAGE)
     results = Echo(processes, '/result')
     graphs = launches('result_graph', GRAPHS)

@@ -34,7 +34,7 @@ import yaml
 
 from tb3_harness.map_quality import measure
 from tb3_harness.report import figure
-from tb3_harness.screen import save_png, screen_env, screenshot, start_xvfb
+from tb3_harness.screen import save_png, screenshot
 from tb3_harness.waypoints import WORLD_LOOP_START
 
 from tb3_system_utils import run, wait_until
@@ -135,16 +135,12 @@ def check_map(yaml_file):
 
 
 @pytest.fixture
-def desktop(processes, tmp_path, monkeypatch):
+def desktop(screen, tmp_path, monkeypatch):
     """A fresh HOME and a screen: (HOME, DISPLAY)."""
     home = tmp_path / 'home'
     home.mkdir()
-    xvfb, display = start_xvfb()
-    processes.started.append(xvfb)
     monkeypatch.setenv('HOME', str(home))
-    for name, value in screen_env(display).items():
-        monkeypatch.setenv(name, value)
-    return str(home), display
+    return str(home), screen
 
 
 def test_map_save_and_navigate_as_the_emanual_does(ros_port, processes, desktop):

@@ -24,7 +24,7 @@ from tb3_harness.mapping import _node_pid
 from tb3_harness.measure import cpu_seconds
 from tb3_harness.processes import Process, start_master, wait_until
 from tb3_harness.report import figure, map_figures
-from tb3_harness.screen import save_png, screen_env, screenshot, start_xvfb
+from tb3_harness.screen import save_png, screenshot
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 BOXED_IN = os.path.join(HERE, '..', 'data', 'worlds', 'boxed_in.yaml')
@@ -47,13 +47,10 @@ def _idle_after_done(log, pid):
     return _read(log).count('explore: [') - before, (cpu_seconds(pid) - cpu) / IDLE_WATCH
 
 
-def test_exploration_maps_turtlebot3_world_alone(tmp_path, monkeypatch):
-    folder = str(tmp_path)
+def test_exploration_maps_turtlebot3_world_alone(tmp_path, monkeypatch, screen):
+    folder, display = str(tmp_path), screen
     monkeypatch.setenv('TURTLEBOT3_MODEL', 'burger')
     master = start_master(folder)
-    xvfb, display = start_xvfb()
-    for name, value in screen_env(display).items():
-        monkeypatch.setenv(name, value)
     pictures = []
 
     def picture():
@@ -66,7 +63,6 @@ def test_exploration_maps_turtlebot3_world_alone(tmp_path, monkeypatch):
             'bash', '-c', 'roslaunch tb3_sim_bringup tb3_slam.launch explore:=true'])
     finally:
         master.stop()
-        xvfb.stop()
     view = map_view(pictures[0])
     walls, floor = colour_pixels(view, WALL, 8), colour_pixels(view, FLOOR, 8)
     print('MEASURED rviz after exploring: %d wall pixels, %d floor pixels' % (walls, floor))

@@ -25,7 +25,7 @@ import rospkg
 
 from tb3_harness import leftovers
 from tb3_harness.navigating import BURGER_FOOTPRINT, clearance
-from tb3_harness.screen import save_png, screen_env, screenshot, start_xvfb
+from tb3_harness.screen import save_png, screenshot
 
 from tb3_system_utils import Echo, alive, poses, run, wait_until
 
@@ -71,13 +71,9 @@ def launches(processes):
 
 
 @pytest.fixture
-def display(processes, monkeypatch):
+def display(screen):
     """A screen of the test's own for rviz (DISPLAY set for what the test starts)."""
-    xvfb, display = start_xvfb()
-    processes.add(xvfb, server=True)
-    for name, value in screen_env(display).items():
-        monkeypatch.setenv(name, value)
-    return display
+    return screen
 
 
 def ours(launch):
