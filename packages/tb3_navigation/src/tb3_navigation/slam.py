@@ -59,9 +59,9 @@ JUMP_SEARCH = 3
 #: is made anew (at 0.22 m/s, 2 s of driving when the map does not change).
 FIELD_SLACK = 0.5
 #: After a loop closure the map is drawn anew from every scan of the graph, this many at each scan that
-#: comes in: all at once, the 700 scans of a drive round the house took 1.5 s of CPU in one scan's
-#: update, and a simulator in lockstep waits 0.5 s at most (doc/speed.md). Meanwhile the pose follows the
-#: odometry (the old map's walls lie where the drift drew them): 14 scans, 2.8 s, on that drive.
+#: comes in: all at once, a redraw on the drive round the outside of the house took 2 s of CPU in one
+#: scan's update, and a simulator in lockstep waits 0.5 s at most (doc/speed.md). Meanwhile the pose
+#: follows the odometry (the old map's walls lie where the drift drew them): 13 or 14 scans a closure there.
 REDRAW_PER_SCAN = 50
 
 
