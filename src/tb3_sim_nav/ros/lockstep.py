@@ -11,6 +11,8 @@ import xmlrpc.client
 import rosgraph
 import rospy
 
+from tb3_common import wake
+
 from ..quiescence import InputWaits, ProcessGone, ProcessWatch
 from . import rospy_internals
 
@@ -77,6 +79,8 @@ class Lockstep(object):
         self._connecting = False  # some of them still shaking hands
         self._ask_again_at = math.inf  # when to ask a local node that did not tell its PID
         self._watches = {}   # publisher node name -> ProcessWatch of its process
+        self._wakes = {}     # publisher node name -> wake.Reader of its notice
+        self._clock_ns = None  # the /clock tick the last wait followed
         self._behind = set()  # node names not waited for until seen waiting
         self.receive_threads = InputWaits()  # the threads that ran our cmd_vel callbacks
         self._ran = set()  # nodes seen running since this process's other threads were last seen asleep
@@ -143,6 +147,7 @@ class Lockstep(object):
         names = set(name for name, _, _ in connected)
         for name in set(self._watches) - names:
             self._watches.pop(name).close()
+            self._wakes.pop(name).close()
             self._behind.discard(name)
         self.receive_threads.clear()  # ended connections' threads; live ones come back
         unknown = []
@@ -157,6 +162,7 @@ class Lockstep(object):
                 pid = local_pid(connection, uri)
                 if pid is not None:
                     self._watches[name] = ProcessWatch(pid)
+                    self._wakes[name] = wake.Reader(pid)
             except ProcessGone:
                 pass
             except LookupError as error:
@@ -213,14 +219,22 @@ class Lockstep(object):
             time.sleep(self._poll)  # a thread that is not asleep may need the interpreter's lock
         return True
 
-    def wait(self, requests=None):
+    def wait(self, requests=None, clock_ns=None):
         """Waits until the nodes followed have reacted to the last step; with `requests` (loop.Requests),
-        also serves what they asked for meanwhile, and waits for their reaction to the answers."""
+        also serves what they asked for meanwhile, and waits for their reaction to the answers.
+
+        `clock_ns`: the step's only news was this /clock tick (its data were waited for before it went
+        out): a node whose notice (tb3_common.wake) says it does nothing before a later time is not
+        looked at. Not after time went back (a reset): every node wakes then."""
         self._follow_publishers()
         # A node left behind and now seen waiting has reacted: no second look.
         recovered = set(name for name in self._behind if self._reacted(name))
         self._behind -= recovered
         pending = [name for name in self._watches if name not in self._behind and name not in recovered]
+        if clock_ns is not None:
+            went_back, self._clock_ns = self._clock_ns is not None and clock_ns < self._clock_ns, clock_ns
+            if not went_back:
+                pending = [name for name in pending if self._wakes[name].next_wake() <= clock_ns]
         deadline = time.monotonic() + self._timeout
         if not self._settle(pending, deadline):
             return

@@ -140,7 +140,7 @@ class SimulatorNode(object):
             # what they asked of Gazebo's services meanwhile. Paced, they have had
             # the sleep to react: one look mostly finds them done.
             if self.lockstep:
-                self.lockstep.wait(self.requests)
+                self.lockstep.wait(self.requests, clock_ns=self.sim.now_ns)
             self.step()
 
     def step(self):

@@ -146,7 +146,12 @@ class Env(_Base):
 
     def _next_scan(self, after):
         """The first scan after the `after`th, with the robot's pose then: ROBOTIS' wait_for_message
-        ('scan', timeout=5) in a loop, which warns here each time it waits `scan_timeout` in vain."""
+        ('scan', timeout=5) in a loop, which warns here each time it waits `scan_timeout` in vain.
+        Only data wakes this process meanwhile: the simulator need not wait for its reaction to /clock."""
+        with self.life.waiting_for_data():
+            return self._await_scan(after)
+
+    def _await_scan(self, after):
         waited = 0.0
         while True:
             with self._condition:

@@ -16,13 +16,18 @@ shutdown that rospy starts in another thread first asks the loop to stop and
 waits (briefly) until it has. A thread watches the parent: a node started by
 roslaunch or rostest ends when they are gone instead of living on as an orphan.
 """
+import atexit
+import contextlib
 import faulthandler
 import os
 import signal
+import sys
 import threading
 import time
 
 import rospy
+
+from .. import wake
 
 PARENT_POLL = 0.5  # wall s between looks at the parent process
 LOOP_STOP_WAIT = 1.0  # wall s a shutdown from another thread waits for the node's loop to stop
@@ -55,12 +60,21 @@ class Life(object):
     with `sleep` (wall time) or `sleep_sim` (ROS time), never rospy.sleep or
     rospy.Rate, and then calls `finish()`; a node driven by callbacks calls
     `spin()`.
+
+    A Life made by init_node also keeps the node's wake.Notice: while every
+    thread that acts of its own accord (those that called `sleep_sim`, or
+    entered `waiting_for_data` or `spin`) waits, the simulator's lockstep
+    need not wait for the node's reaction to /clock ticks before the
+    earliest of their wake-ups.
     """
 
-    def __init__(self):
+    def __init__(self, notice=None):
         self._stop = threading.Event()
         self._loop_done = threading.Event()
         self.reason = None
+        self._notice = notice
+        self._wakes = {}  # thread id -> sim ns before which it does nothing of its own accord (wake.ACTING: now)
+        self._wakes_lock = threading.Lock()
 
     def request_stop(self, reason):
         """Safe in a signal handler: sets the flag (and arms the stacks' print, STACKS_AFTER)."""
@@ -84,13 +98,45 @@ class Life(object):
         condition = rospy.rostime.get_rostime_cond()
         start = rospy.get_rostime()
         end = start + rospy.Duration(seconds)
-        while not self.stopping:
-            now = rospy.get_rostime()
-            if now >= end or now < start:
-                return True
-            with condition:
-                condition.wait(0.1)
+        with self._waking_at(end.to_nsec()):
+            while not self.stopping:
+                now = rospy.get_rostime()
+                if now >= end or now < start:
+                    return True
+                with condition:
+                    condition.wait(0.1)
         return False
+
+    def waiting_for_data(self):
+        """A context in which the calling thread waits for messages only (no timed wake-up)."""
+        return self._waking_at(wake.NEVER)
+
+    @contextlib.contextmanager
+    def _waking_at(self, ns):
+        """The calling thread does nothing of its own accord before sim time `ns` (an int, as sleep_sim's
+        `now >= end` compares) until the context ends; from then on it may act at any tick."""
+        if self._notice is None:
+            yield
+            return
+        thread = threading.get_ident()
+        self._set_wake(thread, ns)
+        try:
+            yield
+        finally:
+            self._set_wake(thread, wake.ACTING)
+
+    def close_notice(self):
+        """The notice file removed (the node ends; also at the process's exit)."""
+        with self._wakes_lock:
+            notice, self._notice = self._notice, None
+        if notice is not None:
+            notice.close()
+
+    def _set_wake(self, thread, ns):
+        with self._wakes_lock:
+            self._wakes[thread] = ns
+            if self._notice is not None:
+                self._notice.write(min(self._wakes.values()))
 
     def callback(self, function):
         """`function` as a rospy callback that ends quietly: it does not run once an end was asked for,
@@ -109,13 +155,15 @@ class Life(object):
 
     def spin(self):
         """Until an end is asked for (callbacks run in rospy's threads meanwhile); then finish()."""
-        while self.sleep(0.1):
-            pass
+        with self.waiting_for_data():
+            while self.sleep(0.1):
+                pass
         self.finish()
 
     def finish(self):
         """The node's loop has stopped: shut rospy down from here (it closes every connection)."""
         self._loop_done.set()
+        self.close_notice()
         rospy.signal_shutdown(self.reason or 'asked to end')
 
     # --- the ways an end comes --------------------------------------------------
@@ -150,7 +198,14 @@ def init_node(name, watch_clock=True, **keywords):
     Call from the main thread, as rospy.init_node; handlers installed before it
     registers, so that no signal finds rospy's own. `watch_clock`: see
     warn_when_left_on_wall_time (the simulator, which publishes /clock, says False)."""
-    life = Life()
+    try:
+        notice = wake.Notice()
+    except OSError as error:  # no shared memory: the simulator waits for this node at every tick
+        notice = None
+        sys.stderr.write('%s: no lockstep notice (%s): a simulator waits for this node at every tick\n'
+                         % (name, error))
+    life = Life(notice)
+    atexit.register(life.close_notice)
     life.handle_signals()
     rospy.init_node(name, disable_signals=True, **keywords)
     rospy.on_shutdown(life._on_rospy_shutdown)
