@@ -4,8 +4,9 @@ A grid of H x W cells is a graph whose edges join each cell to its 4 or 8
 neighbours; stepping into cell c costs `step_costs[c]` times the step's
 length (1, or sqrt(2) for a diagonal), and a cell whose step cost is inf
 cannot be entered. The global planner uses it with navfn's cell costs
-(8 neighbours, from the robot's cell); the controller with unit costs
-(4 neighbours, cells away from the plan, as base_local_planner's MapGrid).
+(8 neighbours, from the robot's cell); the controller counts steps
+(4 neighbours, cells away from the plan, as base_local_planner's MapGrid)
+with step_counts, a breadth-first search.
 
 The edges' layout depends on the grid's shape only, so it is built once per
 shape and kept; a graph then costs one pass of numpy over the edges (11 ms
@@ -19,7 +20,7 @@ import math
 
 import numpy as np
 from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
+from scipy.sparse.csgraph import breadth_first_order, dijkstra
 
 UNREACHED = -9999  # scipy's predecessor of a source or of a cell no path reaches
 
@@ -87,10 +88,33 @@ def shortest_paths(graph, shape, sources, limit=np.inf):
     return distances.reshape(shape), predecessors.reshape(shape)
 
 
-def distances_from(graph, shape, sources):
-    """The distances (H, W) of shortest_paths, without the predecessors."""
-    distances = dijkstra(graph, indices=np.atleast_1d(np.asarray(sources, dtype=np.intp)), min_only=True)
-    return distances.reshape(shape)
+def step_counts(blocked, sources):
+    """The fewest 4-neighbour steps (H, W) from the nearest of `sources` (flat indices) to each
+    cell, never into a `blocked` one (a blocked source is left all the same); inf where none
+    reaches: shortest_paths' distances over build(where(blocked, inf, 1), 4), by a breadth-first search
+    from one node more, joined to every source (60 x 60 cells: 0.55 ms, Dijkstra 1.55 ms)."""
+    height, width = shape = np.shape(blocked)
+    cells = height * width
+    indptr, targets = _edges(shape, 4)[:2]
+    kept = ~np.asarray(blocked, dtype=bool).ravel()[targets]
+    rows = np.empty(cells + 2, dtype=np.int32)
+    rows[0] = 0
+    np.cumsum(np.add.reduceat(kept, indptr[:-1], dtype=np.int32), out=rows[1:cells + 1])
+    sources = np.asarray(sources, dtype=np.int32).ravel()
+    rows[cells + 1] = rows[cells] + len(sources)
+    columns = np.concatenate((targets[kept], sources))
+    graph = csr_matrix((np.ones(len(columns)), columns, rows), shape=(cells + 1, cells + 1))
+    _, parents = breadth_first_order(graph, cells, directed=True, return_predecessors=True)
+    # Each cell's depth in the search's tree, by pointer jumping: every round adds the depth of
+    # the ancestor it points at and points twice as far up (7 rounds for 60 x 60 cells).
+    reached = parents >= 0
+    up = np.where(reached, parents, cells).astype(np.int32)
+    up[cells] = cells
+    depth = reached.astype(np.int32)
+    while (up != cells).any():
+        depth += depth[up]
+        up = up[up]
+    return np.where(reached[:cells], depth[:cells] - 1.0, np.inf).reshape(shape)
 
 
 def path_to(predecessors, target):

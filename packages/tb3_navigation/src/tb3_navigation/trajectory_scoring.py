@@ -35,7 +35,7 @@ import math
 import numpy as np
 
 from tb3_navigation.costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION
-from tb3_navigation.grid_graph import build, distances_from
+from tb3_navigation.grid_graph import step_counts
 
 CHUNK = 64  # trajectories whose footprints are checked together
 CLOSE = 1e4  # added to a trajectory nearer to an obstacle than obstacle_clearance: more than any other term
@@ -89,10 +89,9 @@ class TrajectoryScorer(object):
         scale_path = config.path_distance_bias * grid.resolution
         scale_goal = config.goal_distance_bias * grid.resolution
         cells = _plan_cells(costmap, dense)
-        graph = build(np.where(blocked, np.inf, 1.0), 4)  # one graph for the three: 8 % of move_base's time each
         ahead = config.forward_point_scoring  # false: TrajectoryPlannerROS's critics, the end point alone
-        return dict(path=_steps_from(graph, blocked, cells), goal=_steps_from(graph, blocked, cells[-1:]),
-                    front=_steps_from(graph, blocked, _plan_cells(costmap, front)[-1:]) if ahead else None,
+        return dict(path=_steps_from(blocked, cells), goal=_steps_from(blocked, cells[-1:]),
+                    front=_steps_from(blocked, _plan_cells(costmap, front)[-1:]) if ahead else None,
                     scale_path=scale_path, scale_goal=scale_goal, scale_front=scale_goal if ahead else 0.0,
                     scale_alignment=0.0 if near_goal or not ahead else scale_path)
 
@@ -205,14 +204,13 @@ def _plan_cells(costmap, points):
     return cells[:, 1] * grid.width + cells[:, 0]
 
 
-def _steps_from(graph, blocked, sources):
-    """4-neighbour step counts (H, W) over `graph` (unit steps, blocked cells not
-    enterable) from the nearest source around blocked cells; blocked cells count
-    H * W (MapGrid's obstacleCosts), unreached ones H * W + 1."""
+def _steps_from(blocked, sources):
+    """4-neighbour step counts (H, W) from the nearest source around blocked cells;
+    blocked cells count H * W (MapGrid's obstacleCosts), unreached ones H * W + 1."""
     size = blocked.size
     if not len(sources):
         return np.full(blocked.shape, size + 1.0)
-    distances = distances_from(graph, blocked.shape, sources)
+    distances = step_counts(blocked, sources)
     distances[blocked] = np.where(np.isfinite(distances[blocked]), distances[blocked], size)
     return np.where(np.isfinite(distances), distances, size + 1.0)
 
