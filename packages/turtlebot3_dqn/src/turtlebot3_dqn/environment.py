@@ -19,6 +19,14 @@ persistent service connections; the pose is the last odometry stamped
 before the scan (odom and scan of one step come on two connections, in
 either order); no wall-time sleeps (respawnGoal's time.sleep(0.5)); the goal
 box is deleted and spawned without waiting for gazebo/model_states.
+
+While step() and reset() wait for the next scan, the process tells the
+simulator's lockstep that only data wakes it (tb3_common.wake), so the
+simulator does not wait for its reaction to the /clock ticks in between.
+An Env that starts its own node (rospy not yet initialised) says so for the
+whole process: code of yours that acts on sim time in another thread
+meanwhile should start its node first (rospy.init_node), and the simulator
+then waits for the process at every tick.
 """
 import collections
 import os
