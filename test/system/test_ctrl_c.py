@@ -143,7 +143,7 @@ def test_the_simulator_ends_when_roslaunch_is_killed(ros_port, processes):
 @pytest.mark.parametrize('how', ['SIGTERM', 'rosnode kill', 'a node of the same name', 'Ctrl+C while paused'])
 def test_every_other_way_to_end_the_simulator_takes_under_2_s(how, ros_port, processes):
     """At factor 0 with the readers connected: `kill` (SIGTERM), `rosnode kill
-    /tb3_sim`, the master's shutdown request when a node registers as /tb3_sim,
+    /tb3_sim` (its request), the master's shutdown request when a node registers as /tb3_sim,
     and Ctrl+C while the simulation is paused."""
     processes.start_master('roscore', ros_port)
     for topic in READERS:
@@ -156,13 +156,20 @@ def test_every_other_way_to_end_the_simulator_takes_under_2_s(how, ros_port, pro
     if how == 'Ctrl+C while paused':
         assert run(['rosservice', 'call', '/gazebo/pause_physics'], 30.0).returncode == 0
     time.sleep(1.0)
+    # The clock starts when the request is made: not counting the start-up of a python process that
+    # makes it (1-2 s of a loaded VM's wall time, 2026-11-28), which is not the simulator's.
     asked = time.monotonic()
     if how == 'SIGTERM':
         os.kill(simulator, signal.SIGTERM)
     elif how == 'rosnode kill':
-        assert run(['rosnode', 'kill', '/tb3_sim'], 30.0).returncode == 0
+        import rosnode  # the request `rosnode kill /tb3_sim` makes, from this process
+        assert rosnode.kill_nodes(['/tb3_sim'])[0] == ['/tb3_sim']
     elif how == 'a node of the same name':
-        processes.start('impostor', [sys.executable, '-c', 'import rospy; rospy.init_node("tb3_sim"); rospy.spin()'])
+        impostor = processes.start('impostor', [sys.executable, '-c',
+                                                'import rospy; rospy.init_node("tb3_sim"); rospy.spin()'])
+        # The master asks the first to end as it registers the second.
+        assert wait_until(lambda: registered('/tb3_sim', impostor.pid), READY_TIMEOUT, poll=0.01), impostor.describe()
+        asked = time.monotonic()
     else:
         os.kill(launch.pid, signal.SIGINT)
     gone = wait_until(lambda: not alive(simulator), 20.0, poll=0.02)
