@@ -200,3 +200,26 @@ def test_flushing_a_connection_whose_reader_went_away_closes_it(pairs):
     while len(pairs.backlogs) and time.monotonic() < deadline:
         pairs.backlogs.flush()
     assert len(pairs.backlogs) == 0 and connection.closed
+
+
+def test_nagle_is_off_and_each_write_names_its_reader_and_topic(pairs):
+    """Lockstep counts a message as sent when it is written: Nagle's algorithm, which rospy leaves on
+    for subscribers that do not ask for tcp_nodelay, held odometry up to 40 ms in the kernel (the
+    DQN agent's, 2026-11-28). And it waits only for the nodes a step's data may wake, by topic."""
+    written = set()
+    listener = socket.socket()
+    listener.bind(('127.0.0.1', 0))
+    listener.listen(1)
+    writer = socket.create_connection(listener.getsockname())
+    reader, _ = listener.accept()
+    try:
+        assert writer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) == 0
+        connection = NonBlockingConnection(Connection(writer, '/agent'), '/odom', Backlogs(), lambda c: None,
+                                           written=written)
+        assert writer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) != 0
+        connection.write_data(message(1))
+        assert written == {('/agent', '/odom')}
+        assert Reader(reader).read() == [1]
+    finally:
+        for sock in (listener, writer, reader):
+            sock.close()

@@ -28,6 +28,8 @@ class Publishers(object):
     def __init__(self, throttle):
         self.backlogs = Backlogs()
         self._throttle = throttle
+        #: (caller id, topic) of each subscriber written to since the step loop last cleared it.
+        self.written = set()
 
     def advertise(self, topic, message_class, latch=False, on_subscribe=None):
         """A publisher whose publish() writes to every subscriber at once and in
@@ -39,7 +41,8 @@ class Publishers(object):
                                         subscriber_listener=listener)
         rospy_internals.wrap_connections(
             publisher, lambda connection: NonBlockingConnection(connection, publisher.resolved_name,
-                                                                self.backlogs, self._on_drop))
+                                                                self.backlogs, self._on_drop,
+                                                                written=self.written))
         return publisher
 
     def flush(self):

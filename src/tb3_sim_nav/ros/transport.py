@@ -18,6 +18,7 @@ for that subscriber only, as roscpp (and so Gazebo) drops them for a reader
 that falls behind. A message begun is always finished, so the stream stays
 whole; when the reader reads again it gets the newest messages.
 """
+import socket
 import threading
 from collections import deque
 
@@ -50,14 +51,17 @@ class NonBlockingConnection(object):
     `close`) and behaves as one, but its write_data never waits.
 
     `on_drop(connection)` is called after messages were dropped; `dropped`
-    counts them.
+    counts them. `written`, a set, gets (the subscriber's caller id, `topic`) at each write.
     """
 
-    def __init__(self, connection, topic, backlogs, on_drop, max_messages=MAX_MESSAGES, max_bytes=MAX_BYTES):
+    def __init__(self, connection, topic, backlogs, on_drop, max_messages=MAX_MESSAGES, max_bytes=MAX_BYTES,
+                 written=None):
         self._connection = connection
         self.topic = topic
         self._backlogs = backlogs
         self._on_drop = on_drop
+        self._written = written
+        self._reader = connection.endpoint_id  # rospy sets it in the handshake, before it adds the connection
         self.max_messages, self.max_bytes = max_messages, max_bytes
         self.dropped = 0
         self._lock = threading.Lock()  # the step loop and rospy's thread that sends a latched message
@@ -66,6 +70,14 @@ class NonBlockingConnection(object):
         self._head_sent = 0      # bytes of the first pending message already sent
         if connection.socket is not None:
             connection.socket.setblocking(False)
+            # rospy leaves Nagle's algorithm on for a subscriber that asks for it, as rospy's and roscpp's do
+            # by default (tcp_nodelay 0 in its header): a small message written while one before it is not
+            # yet acknowledged then waits in the kernel for the reader's delayed acknowledgement, up to
+            # 40 ms. A reader then gets, late in wall time, data the simulator's lockstep counts as sent.
+            try:
+                connection.socket.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            except (OSError, AttributeError):  # not a TCP socket
+                pass
 
     def __getattr__(self, name):
         if name.startswith('__'):
@@ -80,6 +92,8 @@ class NonBlockingConnection(object):
     def write_data(self, data):
         """Send `data` (one serialised message) now, or keep it for later, in order.
         Raises OSError when the subscriber has gone (rospy then drops it)."""
+        if self._written is not None:
+            self._written.add((self._reader, self.topic))
         with self._lock:
             if not self._pending:
                 sent = self._send(data)
