@@ -117,3 +117,19 @@ def test_awaiting_is_said_only_by_a_node_that_declared_the_topics_it_stores(tmp_
         assert reader.next_wake() == wake.NEVER
     life.close_notice()
     assert wake.Reader(os.getpid(), str(tmp_path)).stored() == frozenset()
+
+
+def test_a_thread_that_ended_does_not_keep_the_node_acting(tmp_path):
+    notice = wake.Notice(str(tmp_path))
+    reader = wake.Reader(os.getpid(), str(tmp_path))
+    life = Life(notice)
+
+    def waits_once():
+        with life.waiting_for_data():
+            pass
+    worker = threading.Thread(target=waits_once)
+    worker.start()
+    worker.join(5.0)
+    with life.waiting_for_data():
+        assert reader.next_wake() == wake.NEVER
+    life.close_notice()

@@ -146,6 +146,10 @@ class Life(object):
     def _set_wake(self, thread, ns):
         with self._wakes_lock:
             self._wakes[thread] = ns
+            if len(self._wakes) > 1:  # a thread that ended said ACTING last: it must not say so for ever
+                alive = set(running.ident for running in threading.enumerate())
+                for ended in [other for other in self._wakes if other not in alive]:
+                    del self._wakes[ended]
             if self._notice is not None:
                 self._notice.write(wake.combined(self._wakes.values()))
 
