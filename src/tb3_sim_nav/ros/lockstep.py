@@ -68,7 +68,8 @@ class Lockstep(object):
     waited for until it is seen waiting again: the simulator never stalls on it.
     """
 
-    def __init__(self, timeout, poll, warnings, warn_period):
+    def __init__(self, timeout, poll, warnings, warn_period, prompt=None):
+        """`prompt`: a set this keeps to the names of the nodes it waits for (Publishers.prompt)."""
         self._subscribers = []  # the cmd_vel subscribers of every robot
         self._readers = []  # the scan publishers of every robot
         self._timeout = timeout
@@ -85,6 +86,7 @@ class Lockstep(object):
         self.receive_threads = InputWaits()  # the threads that ran our cmd_vel callbacks
         self._ran = set()  # nodes seen running since this process's other threads were last seen asleep
         self._own = None  # ProcessWatch of this process's threads but the step loop's
+        self._prompt = set() if prompt is None else prompt
 
     def follow(self, subscriber):
         """Wait also for the publishers of `subscriber` (a robot's cmd_vel)."""
@@ -147,6 +149,7 @@ class Lockstep(object):
         names = set(name for name, _, _ in connected)
         for name in set(self._watches) - names:
             self._watches.pop(name).close()
+            self._prompt.discard(name)
             self._wakes.pop(name).close()
             self._behind.discard(name)
         self.receive_threads.clear()  # ended connections' threads; live ones come back
@@ -162,6 +165,7 @@ class Lockstep(object):
                 pid = local_pid(connection, uri)
                 if pid is not None:
                     self._watches[name] = ProcessWatch(pid)
+                    self._prompt.add(name)
                     self._wakes[name] = wake.Reader(pid)
             except ProcessGone:
                 pass

@@ -69,7 +69,8 @@ class SimulatorNode(object):
             # Paced, a step has wall time to spare: look less often, for less CPU.
             factor = config.real_time_factor
             poll = max(LOCKSTEP_POLL, LOCKSTEP_POLL_SHARE / config.physics_rate / factor) if factor else LOCKSTEP_POLL
-            self.lockstep = Lockstep(config.lockstep_timeout, poll, self._throttle, WARN_PERIOD)
+            self.lockstep = Lockstep(config.lockstep_timeout, poll, self._throttle, WARN_PERIOD,
+                                     self.publishers.prompt)
         world_links = WorldLinks(config.world_frame, ()) if config.world_frame else None
         descriptions = Descriptions(parameters, self.publishers, config.robot_state_publisher)
         self.fleet = Fleet(simulation, self.publishers, self._throttle, descriptions, self.lockstep, world_links)

@@ -51,17 +51,25 @@ class NonBlockingConnection(object):
     `close`) and behaves as one, but its write_data never waits.
 
     `on_drop(connection)` is called after messages were dropped; `dropped`
-    counts them. `written`, a set, gets (the subscriber's caller id, `topic`) at each write.
+    counts them. `written`, a set, gets (the subscriber's caller id, `topic`) at each write. If
+    the subscriber's caller id is in `prompt` (a set), Nagle's algorithm is turned off before the
+    write: rospy lets a subscriber's tcp_nodelay choose (0, rospy's and roscpp's default, keeps it
+    on), and a small message written while one before it is not yet acknowledged then waits in the
+    kernel for the reader's delayed acknowledgement, up to 40 ms: late for a node whose reaction the
+    lockstep waits for. Others keep their choice: many small messages (/clock, 100 a sim second)
+    then fill fewer segments, and a slow reader's socket holds more of them.
     """
 
     def __init__(self, connection, topic, backlogs, on_drop, max_messages=MAX_MESSAGES, max_bytes=MAX_BYTES,
-                 written=None):
+                 written=None, prompt=None):
         self._connection = connection
         self.topic = topic
         self._backlogs = backlogs
         self._on_drop = on_drop
         self._written = written
         self._reader = connection.endpoint_id  # rospy sets it in the handshake, before it adds the connection
+        self._prompt = prompt
+        self._no_delay = False
         self.max_messages, self.max_bytes = max_messages, max_bytes
         self.dropped = 0
         self._lock = threading.Lock()  # the step loop and rospy's thread that sends a latched message
@@ -70,14 +78,6 @@ class NonBlockingConnection(object):
         self._head_sent = 0      # bytes of the first pending message already sent
         if connection.socket is not None:
             connection.socket.setblocking(False)
-            # rospy leaves Nagle's algorithm on for a subscriber that asks for it, as rospy's and roscpp's do
-            # by default (tcp_nodelay 0 in its header): a small message written while one before it is not
-            # yet acknowledged then waits in the kernel for the reader's delayed acknowledgement, up to
-            # 40 ms. A reader then gets, late in wall time, data the simulator's lockstep counts as sent.
-            try:
-                connection.socket.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            except (OSError, AttributeError):  # not a TCP socket
-                pass
 
     def __getattr__(self, name):
         if name.startswith('__'):
@@ -94,6 +94,12 @@ class NonBlockingConnection(object):
         Raises OSError when the subscriber has gone (rospy then drops it)."""
         if self._written is not None:
             self._written.add((self._reader, self.topic))
+        if self._prompt is not None and not self._no_delay and self._reader in self._prompt:
+            self._no_delay = True
+            try:
+                self._connection.socket.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            except (OSError, AttributeError):  # not a TCP socket, or closed
+                pass
         with self._lock:
             if not self._pending:
                 sent = self._send(data)
@@ -107,6 +113,8 @@ class NonBlockingConnection(object):
             self._send_pending()
             if self._pending:
                 self._backlogs.add(self)
+            else:  # the socket took the backlog: nothing left for the step loop's flush
+                self._backlogs.discard(self)
         return True
 
     def flush(self):
