@@ -46,8 +46,7 @@ class ProcessWatch(object):
         self._counted = os.path.exists(os.path.join(self._task_dir, str(pid), 'schedstat'))
         self._last = None  # the run counters when last seen waiting
         self._quiet = None  # the run counters when last seen quiet (quiet())
-        #: After waiting() (quiet()): whether it ran since it was last seen waiting (quiet); True when it
-        #: is not.
+        #: After waiting(): whether it ran since it was last seen waiting (True when it is not waiting).
         self.ran = True
 
     def close(self):
@@ -129,9 +128,8 @@ class ProcessWatch(object):
     def quiet(self, pause, sleep=time.sleep):
         """True when every thread sleeps at two looks `pause` s apart and none ran in between: for a
         process looking at its own other threads, which need the interpreter's lock to run and get it
-        in the pause. `ran` then says whether one ran since they were last seen quiet."""
+        in the pause."""
         threads = self._threads()
-        self.ran = True
         first = self._look(threads, states=True)
         if first is None:
             return False
@@ -139,7 +137,6 @@ class ProcessWatch(object):
             # None ran since they were last seen quiet: a thread that received since would have run (a
             # thread woken but not yet run is runnable, not asleep). Most steps end here: the pause cost
             # a step 0.1 ms and more (a sleep's wake-up on a loaded machine).
-            self.ran = False
             return True
         sleep(pause)
         second = self._look(self._threads(), states=True)
