@@ -211,21 +211,11 @@ def test_nagle_is_off_for_the_lockstep_s_nodes(pairs):
     for subscribers that do not ask for tcp_nodelay, held odometry up to 40 ms in the kernel (the
     DQN agent's, 2026-11-28)."""
     prompt = set()
-    listener = socket.socket()
-    listener.bind(('127.0.0.1', 0))
-    listener.listen(1)
-    writer = socket.create_connection(listener.getsockname())
-    reader, _ = listener.accept()
-    try:
-        assert writer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) == 0
-        connection = NonBlockingConnection(Connection(writer, '/agent'), '/odom', Backlogs(), lambda c: None,
-                                           prompt=prompt)
-        connection.write_data(message(1))
-        assert writer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) == 0   # the subscriber's choice
-        prompt.add('/agent')   # the lockstep follows it now
-        connection.write_data(message(2))
-        assert writer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) != 0
-        assert Reader(reader).read() == [1, 2]
-    finally:
-        for sock in (listener, writer, reader):
-            sock.close()
+    connection, reader = pairs('/agent', prompt=prompt)
+    writer = connection.socket
+    connection.write_data(message(1))
+    assert writer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) == 0   # the subscriber's choice
+    prompt.add('/agent')   # the lockstep follows it now
+    connection.write_data(message(2))
+    assert writer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) != 0
+    assert reader.read() == [1, 2]

@@ -51,12 +51,15 @@ class NonBlockingConnection(object):
     `close`) and behaves as one, but its write_data never waits.
 
     `on_drop(connection)` is called after messages were dropped; `dropped`
-    counts them. If the subscriber's caller id is in `prompt` (a set), Nagle's algorithm is turned off before the
-    write: rospy lets a subscriber's tcp_nodelay choose (0, rospy's and roscpp's default, keeps it
-    on), and a small message written while one before it is not yet acknowledged then waits in the
-    kernel for the reader's delayed acknowledgement, up to 40 ms: late for a node whose reaction the
-    lockstep waits for. Others keep their choice: many small messages (/clock, 100 a sim second)
-    then fill fewer segments, and a slow reader's socket holds more of them.
+    counts them. If the subscriber's caller id is in `prompt` (a set),
+    Nagle's algorithm is turned off before the write: rospy lets a
+    subscriber's tcp_nodelay choose (0, rospy's and roscpp's default, keeps
+    it on), and a small message written while one before it is not yet
+    acknowledged then waits in the kernel for the reader's delayed
+    acknowledgement, up to 40 ms: late for a node whose reaction the
+    lockstep waits for. Others keep their choice: many small messages
+    (/clock, 100 a sim second) then fill fewer segments, and a slow reader's
+    socket holds more of them.
     """
 
     def __init__(self, connection, topic, backlogs, on_drop, max_messages=MAX_MESSAGES, max_bytes=MAX_BYTES,
