@@ -206,15 +206,16 @@ def test_flushing_a_connection_whose_reader_went_away_closes_it(pairs):
     assert len(pairs.backlogs) == 0 and connection.closed
 
 
-def test_nagle_is_off_for_the_lockstep_s_nodes(pairs):
+def test_nagle_is_off_for_the_lockstep_s_nodes_and_each_write_names_its_reader_and_topic(pairs):
     """Lockstep counts a message as sent when it is written: Nagle's algorithm, which rospy leaves on
     for subscribers that do not ask for tcp_nodelay, held odometry up to 40 ms in the kernel (the
-    DQN agent's, 2026-11-28)."""
-    prompt = set()
-    connection, reader = pairs('/agent', prompt=prompt)
+    DQN agent's, 2026-11-28). And it waits only for the nodes a step's data may wake, by topic."""
+    written, prompt = set(), set()
+    connection, reader = pairs('/agent', written=written, prompt=prompt)
     writer = connection.socket
     connection.write_data(message(1))
     assert writer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) == 0   # the subscriber's choice
+    assert written == {('/agent', '/topic')}
     prompt.add('/agent')   # the lockstep follows it now
     connection.write_data(message(2))
     assert writer.getsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY) != 0

@@ -94,6 +94,31 @@ def test_a_life_without_a_notice_writes_nothing_and_sleeps_as_before(sim_time):
         pass
 
 
+def test_one_notice_for_the_threads_awaiting_only_while_every_thread_awaits():
+    assert wake.combined([wake.AWAITING, wake.AWAITING]) == wake.AWAITING
+    # A thread waiting for any data is woken by the stored topics too; one asleep until a time wakes then.
+    assert wake.combined([wake.AWAITING, wake.NEVER]) == wake.NEVER
+    assert wake.combined([wake.AWAITING, 5]) == 5
+    assert wake.combined([wake.NEVER, 5, wake.ACTING]) == wake.ACTING
+
+
+def test_awaiting_is_said_only_by_a_node_that_declared_the_topics_it_stores(tmp_path):
+    notice = wake.Notice(str(tmp_path))
+    reader = wake.Reader(os.getpid(), str(tmp_path))
+    life = Life(notice)
+    with life.waiting_for_data(except_stored=True):
+        assert reader.next_wake() == wake.NEVER   # nothing declared: any data wakes it
+    life.stores(['/odom', '/tb3_1/odom'])
+    with life.waiting_for_data(except_stored=True):
+        assert reader.next_wake() == wake.AWAITING
+        assert reader.stored() == frozenset(['/odom', '/tb3_1/odom'])
+    assert reader.next_wake() == wake.ACTING
+    with life.waiting_for_data():   # waiting for odometry: now it wakes the node
+        assert reader.next_wake() == wake.NEVER
+    life.close_notice()
+    assert wake.Reader(os.getpid(), str(tmp_path)).stored() == frozenset()
+
+
 def test_a_thread_that_ended_does_not_keep_the_node_acting(tmp_path):
     notice = wake.Notice(str(tmp_path))
     reader = wake.Reader(os.getpid(), str(tmp_path))

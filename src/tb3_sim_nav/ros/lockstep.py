@@ -250,6 +250,23 @@ class Lockstep(object):
         if requests is not None:
             self._serve(requests, deadline)
 
+    def wait_for_readers(self, written):
+        """After a step that sent data: waits as wait() does if the data may have woken a node followed
+        (`written`: (caller id, topic) of each subscriber written to). Otherwise every node followed
+        sleeps on as the wait before the step left it: no look is needed. Unwoken are the nodes that got
+        nothing (a step of the IMU alone, 100 Hz, reaches neither ROBOTIS' DQN agent nor a SLAM, amcl or
+        move_base), and those that await other data than what they got (tb3_common.wake: the DQN agent
+        stores the odometry, 30 Hz, and acts on each scan, 5 Hz)."""
+        self._follow_publishers()
+        if any(self._woken(name, topic) for name, topic in tuple(written)):  # rospy threads may add
+            self.wait()
+
+    def _woken(self, name, topic):
+        notice = self._wakes.get(name)
+        if notice is None:  # not followed
+            return False
+        return notice.next_wake() != wake.AWAITING or topic not in notice.stored()
+
     def _serve(self, requests, deadline):
         """A node that calls Gazebo's services waits for the answer, asleep: lockstep sees it waiting
         while its request may still be on its way through this process's threads (or its answer on
@@ -263,7 +280,8 @@ class Lockstep(object):
                 if not self._own_threads_settled(deadline):
                     return
                 self._ran.clear()
-                # Our threads' writes (a handshake's reply, an answer) may have woken one.
+                # Our threads' writes (a handshake's reply, an answer) may have woken one; if none of them
+                # ran since last seen quiet, they wrote nothing (a DQN step: 5 of its 6 looks here).
                 if not self._settle(callers, deadline):
                     return
                 if self._ran.intersection(callers):

@@ -145,6 +145,7 @@ class SimulatorNode(object):
             self.step()
 
     def step(self):
+        self.publishers.written.clear()
         self.fleet.apply_commands(self.sim.now_ns)
         self.sim.step()
         now_ns = self.sim.now_ns
@@ -158,7 +159,7 @@ class SimulatorNode(object):
         # node woken by the tick reads this step's tf and odom, not the step
         # before's (lockstep sees that it has): the same at any factor.
         if published and self.lockstep:
-            self.lockstep.wait()
+            self.lockstep.wait_for_readers(self.publishers.written)
         self.clock_pub.publish(Clock(clock=stamp))
 
     def publish_data(self, now_ns, stamp):

@@ -28,6 +28,8 @@ class Publishers(object):
     def __init__(self, throttle):
         self.backlogs = Backlogs()
         self._throttle = throttle
+        #: (caller id, topic) of each subscriber written to since the step loop last cleared it.
+        self.written = set()
         #: Caller ids of the subscribers whose messages must leave at once (the lockstep's nodes).
         self.prompt = set()
 
@@ -42,7 +44,7 @@ class Publishers(object):
         rospy_internals.wrap_connections(
             publisher, lambda connection: NonBlockingConnection(connection, publisher.resolved_name,
                                                                 self.backlogs, self._on_drop,
-                                                                prompt=self.prompt))
+                                                                written=self.written, prompt=self.prompt))
         return publisher
 
     def flush(self):

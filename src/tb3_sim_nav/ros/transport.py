@@ -51,8 +51,9 @@ class NonBlockingConnection(object):
     `close`) and behaves as one, but its write_data never waits.
 
     `on_drop(connection)` is called after messages were dropped; `dropped`
-    counts them. If the subscriber's caller id is in `prompt` (a set),
-    Nagle's algorithm is turned off before the write: rospy lets a
+    counts them. `written`, a set, gets (the subscriber's caller id,
+    `topic`) at each write. If the subscriber's caller id is in `prompt` (a
+    set), Nagle's algorithm is turned off before the write: rospy lets a
     subscriber's tcp_nodelay choose (0, rospy's and roscpp's default, keeps
     it on), and a small message written while one before it is not yet
     acknowledged then waits in the kernel for the reader's delayed
@@ -63,11 +64,12 @@ class NonBlockingConnection(object):
     """
 
     def __init__(self, connection, topic, backlogs, on_drop, max_messages=MAX_MESSAGES, max_bytes=MAX_BYTES,
-                 prompt=None):
+                 written=None, prompt=None):
         self._connection = connection
         self.topic = topic
         self._backlogs = backlogs
         self._on_drop = on_drop
+        self._written = written
         self._reader = connection.endpoint_id  # rospy sets it in the handshake, before it adds the connection
         self._prompt = prompt
         self._no_delay = False
@@ -93,6 +95,8 @@ class NonBlockingConnection(object):
     def write_data(self, data):
         """Send `data` (one serialised message) now, or keep it for later, in order.
         Raises OSError when the subscriber has gone (rospy then drops it)."""
+        if self._written is not None:
+            self._written.add((self._reader, self.topic))
         if self._prompt is not None and not self._no_delay and self._reader in self._prompt:
             self._no_delay = True
             try:

@@ -13,6 +13,15 @@ a time, or NEVER (only data wakes it, and the steps that send it data are
 waited for anyway). The simulator reads the file between two steps (pread:
 a microsecond) and skips its look at the node on the ticks before that time.
 
+A node may also declare, once, topics whose messages it only stores (its
+callbacks for them act on nothing): ROBOTIS' DQN agent keeps the odometry it
+reads when a scan comes. While its notice says AWAITING (only data wakes it,
+and not data on those topics), the lockstep need not wait for its reaction
+to a step that sent it only such messages: five of the six steps a DQN step
+that send it data. The node must then not act on stored data before all of
+it up to the time it acts on is in (the agent waits for the odometry of its
+scan's time, which comes in the same step: one connection keeps its order).
+
 The file is named after the process's PID and its start time (so that a
 file a killed node left behind never speaks for a later process with its
 PID), in shared memory, and removed when the node ends.
@@ -23,6 +32,7 @@ import tempfile
 
 ACTING = -1              # sim ns: it may act at any tick
 NEVER = (1 << 63) - 1    # sim ns: only data wakes it
+AWAITING = NEVER - 1     # sim ns: only data wakes it, and not data on the topics it declared stored
 _FORMAT = struct.Struct('<q')
 DIRECTORY = '/dev/shm' if os.path.isdir('/dev/shm') else tempfile.gettempdir()
 
@@ -42,6 +52,15 @@ def path_of(pid, directory=DIRECTORY):
     return None if started is None else os.path.join(directory, 'tb3_wake_%d_%d' % (pid, started))
 
 
+def combined(wakes):
+    """A process's notice from its waiting threads' (a non-empty iterable): the earliest, where AWAITING
+    counts as NEVER unless every thread awaits (a thread waiting for any data is woken by stored data)."""
+    wakes = list(wakes)
+    if all(ns == AWAITING for ns in wakes):
+        return AWAITING
+    return min(NEVER if ns == AWAITING else ns for ns in wakes)
+
+
 class Notice(object):
     """This process's notice, written by the node (ACTING until told otherwise)."""
 
@@ -55,6 +74,12 @@ class Notice(object):
         if ns != self.value and self._fd is not None:
             os.pwrite(self._fd, _FORMAT.pack(ns), 0)
             self.value = ns
+
+    def declare_stored(self, topics):
+        """The topics (resolved names) whose messages the node only stores; once, before it first
+        writes AWAITING."""
+        if self._fd is not None:
+            os.pwrite(self._fd, '\n'.join(topics).encode('utf-8'), _FORMAT.size)
 
     def close(self):
         if self._fd is not None:
@@ -75,12 +100,20 @@ class Reader(object):
             self._fd = os.open(path, os.O_RDONLY) if path else None
         except OSError:  # not a node of ours (or an older one): it is waited for at every tick
             self._fd = None
+        self._stored = None
 
     def next_wake(self):
         if self._fd is None:
             return ACTING
         data = os.pread(self._fd, _FORMAT.size, 0)
         return _FORMAT.unpack(data)[0] if len(data) == _FORMAT.size else ACTING
+
+    def stored(self):
+        """The topics the node declared stored: read once, the first time after it said AWAITING."""
+        if self._stored is None:
+            data = os.pread(self._fd, 1 << 16, _FORMAT.size) if self._fd is not None else b''
+            self._stored = frozenset(data.decode('utf-8', 'replace').split('\n')) - {''}
+        return self._stored
 
     def close(self):
         if self._fd is not None:

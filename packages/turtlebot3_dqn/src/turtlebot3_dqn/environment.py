@@ -99,7 +99,8 @@ class Env(_Base):
         self._odometry = collections.deque(maxlen=ODOM_HISTORY)
         topic = (lambda name: namespace.strip('/') + '/' + name) if namespace else (lambda name: name)
         self._cmd_vel = rospy.Publisher(topic('cmd_vel'), Twist, queue_size=5)
-        rospy.Subscriber(topic('odom'), Odometry, self._on_odom, queue_size=ODOM_HISTORY)
+        odom = rospy.Subscriber(topic('odom'), Odometry, self._on_odom, queue_size=ODOM_HISTORY)
+        self.life.stores([odom.resolved_name])  # _next_scan takes the odometry of its scan's time
         rospy.Subscriber(topic('scan'), LaserScan, self._on_scan, queue_size=1)
         self._services = {}
         for name, kind in (('gazebo/reset_simulation', Empty), ('gazebo/spawn_sdf_model', SpawnModel),
@@ -136,6 +137,7 @@ class Env(_Base):
     def _on_odom(self, message):
         with self._condition:
             self._odometry.append((message.header.stamp.to_nsec(), plane_pose(message)))
+            self._condition.notify_all()
 
     def _on_scan(self, message):
         with self._condition:
@@ -155,32 +157,41 @@ class Env(_Base):
     def _next_scan(self, after):
         """The first scan after the `after`th, with the robot's pose then: ROBOTIS' wait_for_message
         ('scan', timeout=5) in a loop, which warns here each time it waits `scan_timeout` in vain.
-        Only data wakes this process meanwhile: the simulator need not wait for its reaction to /clock."""
-        with self.life.waiting_for_data():
-            return self._await_scan(after)
+        Only data wakes this process meanwhile, and odometry alone does not: the simulator need not
+        wait for its reaction to /clock, nor to a step that sent only odometry. So the odometry of the
+        scan's time, sent in the same step on another connection, may come after the scan: it is
+        waited for (then any data wakes this process), and the last odometry before the scan is in."""
+        while True:
+            with self.life.waiting_for_data(except_stored=True):
+                self._await(lambda: self._scans > after, 'scan')
+            with self._condition:
+                scan, after = self._scan, self._scans
+            stamp = scan.header.stamp.to_nsec()
+            with self.life.waiting_for_data():
+                self._await(lambda: self._odometry and self._odometry[-1][0] >= stamp, 'odometry')
+            with self._condition:
+                before = [pose for at, pose in self._odometry if at < stamp]
+            if before:
+                return scan, before[-1]
+            # no odometry before it (the first scan after a reset): the next scan
 
-    def _await_scan(self, after):
+    def _await(self, predicate, what):
+        """Until `predicate()` holds (it reads what rospy's threads write, under the condition)."""
         waited = 0.0
         while True:
             with self._condition:
-                # In slices: a signal only sets the flag, and Ctrl+C ends the simulator too, whose scans
+                # In slices: a signal only sets the flag, and Ctrl+C ends the simulator too, whose data
                 # would have woken this wait.
-                if self._condition.wait_for(lambda: self._scans > after or self.life.stopping, STOP_POLL):
+                if self._condition.wait_for(lambda: predicate() or self.life.stopping, STOP_POLL):
                     if self.life.stopping:
                         raise KeyboardInterrupt('asked to end')
-                    scan = self._scan
-                    stamp = scan.header.stamp.to_nsec()
-                    before = [pose for at, pose in self._odometry if at < stamp]
-                    if before:
-                        return scan, before[-1]
-                    after = self._scans  # no odometry yet: the next scan
-                    continue
+                    return
             if self.life.stopping:
                 raise KeyboardInterrupt('asked to end')
             waited += STOP_POLL
             if waited >= self.scan_timeout:
                 waited = 0.0
-                rospy.logwarn('turtlebot3_dqn: no scan for %.0f s: is the simulation paused?', self.scan_timeout)
+                rospy.logwarn('turtlebot3_dqn: no %s for %.0f s: is the simulation paused?', what, self.scan_timeout)
 
     def _observe(self, scan, pose):
         ranges = core.ranges_of(scan.ranges, scan.range_min)

@@ -75,6 +75,7 @@ class Life(object):
         self._notice = notice
         self._wakes = {}  # thread id -> sim ns before which it does nothing of its own accord (wake.ACTING: now)
         self._wakes_lock = threading.Lock()
+        self._stores = False  # it declared topics it only stores
 
     def request_stop(self, reason):
         """Safe in a signal handler: sets the flag (and arms the stacks' print, STACKS_AFTER)."""
@@ -107,9 +108,19 @@ class Life(object):
                     condition.wait(0.1)
         return False
 
-    def waiting_for_data(self):
-        """A context in which the calling thread waits for messages only (no timed wake-up)."""
-        return self._waking_at(wake.NEVER)
+    def waiting_for_data(self, except_stored=False):
+        """A context in which the calling thread waits for messages only (no timed wake-up); with
+        `except_stored`, not for those of the topics declared with stores()."""
+        return self._waking_at(wake.AWAITING if except_stored and self._stores else wake.NEVER)
+
+    def stores(self, topics):
+        """Declares, once, that this node's callbacks for `topics` (resolved names) only store what it reads
+        when other data wakes it (tb3_common.wake): the simulator's lockstep then need not wait for its
+        reaction to them while it waits in waiting_for_data(except_stored=True)."""
+        with self._wakes_lock:
+            if self._notice is not None:
+                self._notice.declare_stored(topics)
+            self._stores = True
 
     @contextlib.contextmanager
     def _waking_at(self, ns):
@@ -140,7 +151,7 @@ class Life(object):
                 for ended in [other for other in self._wakes if other not in alive]:
                     del self._wakes[ended]
             if self._notice is not None:
-                self._notice.write(min(self._wakes.values()))
+                self._notice.write(wake.combined(self._wakes.values()))
 
     def callback(self, function):
         """`function` as a rospy callback that ends quietly: it does not run once an end was asked for,
