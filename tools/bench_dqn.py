@@ -16,7 +16,7 @@ at Gazebo's real time (their sim time).
     python3 tools/bench_dqn.py [--eval-every 20] [--eval-episodes 20] [--target 0.8] [--max-minutes 45]
                                [--png doc/dqn_stage_1.png] [--csv FILE]
 """
-import turtlebot3_dqn  # noqa: F401, I001 (first, before numpy: one BLAS thread, see its __init__)
+import turtlebot3_dqn  # noqa: F401, I001 (first, before numpy: one BLAS thread, see tb3_common)
 
 import argparse
 import datetime
