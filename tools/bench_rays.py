@@ -61,6 +61,62 @@ def measure(casts, world_name, poses):
     return times, [[value if math.isfinite(value) else str(value) for value in scan] for scan in ranges]
 
 
+def map_world(rounds, repeats=15):
+    """Table rows (label, value) of test_map's load time and its lidar cost against turtlebot3_world's."""
+    import numpy as np
+
+    import tb3_sim_nav.world
+    from tb3_sim_nav.world import World
+    from tb3_sim_nav.world_file import load_world
+    test_map, worlds = os.path.join(ROOT, 'maps', 'rbx1', 'test_map.yaml'), os.path.join(ROOT, 'worlds')
+    loads = []
+    for _ in range(rounds):
+        start = time.process_time()  # CPU of this process, pybullet's included
+        loaded = load_world(test_map, worlds)
+        parsed = time.process_time()
+        World(0.01, loaded.obstacles).close()
+        loads.append((parsed - start, time.process_time() - parsed))
+    angles = np.arange(360) * 2 * math.pi / 360
+    directions = np.stack((np.cos(angles), np.sin(angles), np.zeros(360)), -1)
+
+    def scan_cost(world, spots):
+        """Mean CPU s of a 3.5 m scan at the Burger's lidar height from each (x, y) of `spots`."""
+        total = 0.0
+        for x, y in spots:
+            origin = np.array([x, y, 0.182])
+            world.cast([origin], [directions], 3.5, [None])
+            start = time.process_time()
+            for _ in range(repeats):
+                world.cast([origin], [directions], 3.5, [None])
+            total += time.process_time() - start
+        return total / repeats / len(spots)
+
+    # Three free spots of each: the book's living and dining rooms; the launch's spawn, among the pillars, a corner.
+    map_spots, world_spots = [(0.0, 0.0), (0.72, 2.23), (-0.86, 0.0)], [(-2.0, -0.5), (0.5, 0.5), (1.6, 1.6)]
+    mapped = World(0.01, loaded.obstacles)
+    reference = World(0.01, load_world('turtlebot3_world', worlds).obstacles)
+    every_beam, costs = tb3_sim_nav.world.MAX_STILL_SHAPES, []
+    try:
+        for _ in range(rounds):  # interleaved
+            tb3_sim_nav.world.MAX_STILL_SHAPES = every_beam
+            mapped_cost = scan_cost(mapped, map_spots)
+            tb3_sim_nav.world.MAX_STILL_SHAPES = -1
+            costs.append((mapped_cost, scan_cost(reference, world_spots)))
+    finally:
+        tb3_sim_nav.world.MAX_STILL_SHAPES = every_beam
+        mapped.close()
+        reference.close()
+    occupied = int((loaded.map.values == 100).sum())
+    # The fastest of the rounds: what each costs when no other process takes the CPU (2 shared cores).
+    best_map, best_world = min(a for a, _ in costs), min(b for _, b in costs)
+    return [('test_map: occupied cells -> boxes', '%d -> %d' % (occupied, len(loaded.obstacles))),
+            ('test_map load: YAML and boxes, s (median)', '%.3f' % statistics.median(a for a, _ in loads)),
+            ('test_map load: pybullet bodies, s (median)', '%.3f' % statistics.median(b for _, b in loads)),
+            ('360-beam scan in test_map, ms (best)', '%.2f' % (1e3 * best_map)),
+            ('same, turtlebot3_world every beam in pybullet, ms (best)', '%.2f' % (1e3 * best_world)),
+            ('ratio test_map / turtlebot3_world', '%.2f' % (best_map / best_world))]
+
+
 def run(src, casts, world, poses):
     """measure() in a fresh process whose tb3_sim_nav is `src`'s."""
     environment = dict(os.environ, PYTHONPATH=os.pathsep.join(
@@ -89,8 +145,15 @@ def main():
     parser.add_argument('--before', help='the src folder of the tree to compare with')
     parser.add_argument('--rounds', type=int, default=5)
     parser.add_argument('--casts', type=int, default=40, help='read_all calls a round')
+    parser.add_argument('--map-world', action='store_true', help="test_map as a world: load time and lidar cost")
     parser.add_argument('--child', help=argparse.SUPPRESS)
     arguments = parser.parse_args()
+    if arguments.map_world:
+        from tb3_harness.measure import machine
+        print('map world, machine: %s; %d rounds, CPU time of this process' % (machine(), arguments.rounds))
+        for label, value in map_world(arguments.rounds):
+            print('%-58s %12s' % (label, value))
+        return
     if arguments.child:
         print(json.dumps(measure(*json.loads(arguments.child))))
         return
