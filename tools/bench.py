@@ -38,6 +38,12 @@ from tb3_harness.processes import RunError, say, start_master
 TARGETS = {'cpu': 5.0, 'startup': 3.0, 'speedup': 10.0}
 
 
+def cpu_rows(runs):
+    """A row for each process of the runs at factors 1 and 0 (the same processes): its share of a core."""
+    return ['%-58s %5.1f / %.1f %%' % ('    %s' % name, 100 * runs[1.0].cpu[name], 100 * runs[0.0].cpu[name])
+            for name in runs[1.0].cpu]
+
+
 def nav_rows(mapped, navigated):
     """The mapping and navigation chapters' rows: one run each at factor 1 and as fast as possible."""
     slam_1, slam_0, nav_1, nav_0 = mapped[1.0], mapped[0.0], navigated[1.0], navigated[0.0]
@@ -54,12 +60,14 @@ def nav_rows(mapped, navigated):
             '%-58s %5.1f / %.1f %%' % ('  occupied cells on a surface of the world, factor 1 / 0',
                                       100 * slam_1.quality.occupied_near_surface,
                                       100 * slam_0.quality.occupied_near_surface),
+            '  CPU of each process while driving, factor 1 / 0:'] + cpu_rows(mapped) + [
             'navigation (tb3_navigation.launch: amcl and move_base), four goals in turtlebot3_world:',
             '%-58s %11.1f%%' % ('  CPU of amcl and move_base at factor 1 while driving', 100 * nav_1.stack_cpu),
             '%-58s %12.1f' % ('  real-time factor reached with them, as fast as possible',
                               nav_0.sim_seconds / nav_0.wall_seconds),
             '%-58s %12s' % ('  goals reached, factor 1 / 0', ' / '.join(reached)),
-            '%-58s %10.1f cm' % ('  worst true distance from a goal reached', 100 * worst)]
+            '%-58s %10.1f cm' % ('  worst true distance from a goal reached', 100 * worst),
+            '  CPU of each process on the way to the goals, factor 1 / 0:'] + cpu_rows(navigated)
 
 
 def main(argv=None):

@@ -20,8 +20,7 @@ import time
 from test_emanual import FLOOR, SHOTS, WALL, colour_pixels, map_view
 
 from tb3_harness import exploring
-from tb3_harness.mapping import _node_pid
-from tb3_harness.measure import cpu_seconds
+from tb3_harness.measure import cpu_seconds, node_pid
 from tb3_harness.processes import Process, start_master, wait_until
 from tb3_harness.report import figure, map_figures
 from tb3_harness.screen import save_png, screenshot
@@ -95,7 +94,7 @@ def test_a_boxed_in_robot_ends_with_a_clear_message_and_then_idles(tmp_path):
         wait_until(lambda: exploring.progress(_read(slam.log))[2] is not None, BAD_CASE_TIMEOUT,
                    'the explore node\'s end', poll=0.5, watch=started)
         goals, _, done = exploring.progress(_read(slam.log))
-        lines, cpu = _idle_after_done(slam.log, _node_pid('/explore'))
+        lines, cpu = _idle_after_done(slam.log, node_pid('/explore'))
     finally:
         for process in reversed(started):
             process.stop()
@@ -124,7 +123,7 @@ def test_a_move_base_that_aborts_every_goal_makes_exploration_stop(tmp_path):
         wait_until(lambda: exploring.progress(_read(explore.log))[2] is not None, BAD_CASE_TIMEOUT,
                    'the explore node\'s end', poll=0.5, watch=started)
         goals, last, done = exploring.progress(_read(explore.log))
-        lines, cpu = _idle_after_done(explore.log, _node_pid('/explore'))
+        lines, cpu = _idle_after_done(explore.log, node_pid('/explore'))
         aborted = len(re.findall(r'aborted goal \d+', _read(stand_in.log)))
     finally:
         for process in reversed(started):

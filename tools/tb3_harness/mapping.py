@@ -16,7 +16,7 @@ import os
 import time
 
 from .map_quality import measure
-from .measure import cpu_seconds
+from .measure import CpuMeter, node_pid
 from .processes import Process, RunError, master_pid, say, tail, wait_until
 from .waypoints import WORLD_LOOP_START
 
@@ -35,7 +35,7 @@ class MappingRun(object):
     map: list
     sim_seconds: float
     wall_seconds: float
-    slam_cpu: float           # share of a core the SLAM node used while the robot drove
+    cpu: dict                 # {process: share of a core} while the robot drove: tb3_slam, tb3_sim ...
     map_yaml: str
     quality: object           # map_quality.MapQuality
     map_error: tuple          # (m, deg) of the pose in map against the truth, at the end
@@ -43,18 +43,15 @@ class MappingRun(object):
     grid: object = None
     values: object = None
 
+    @property
+    def slam_cpu(self):
+        """The share of a core the SLAM node used while the robot drove."""
+        return self.cpu['tb3_slam']
+
 
 def _error(estimate, truth):
     yaw = (estimate[3] - truth[3] + math.pi) % (2 * math.pi) - math.pi
     return math.hypot(estimate[1] - truth[1], estimate[2] - truth[2]), math.degrees(yaw)
-
-
-def _node_pid(name):
-    import xmlrpc.client
-
-    import rosgraph
-    uri = rosgraph.Master('/tb3_harness').lookupNode(name)
-    return xmlrpc.client.ServerProxy(uri).getPid('/tb3_harness')[2]
 
 
 def map_world(log_dir, output, factor=0.0, profile='realistic', seed=7, world='turtlebot3_world',
@@ -81,14 +78,17 @@ def map_world(log_dir, output, factor=0.0, profile='realistic', seed=7, world='t
         slam = spawn('slam', ['roslaunch', 'tb3_sim_bringup', 'tb3_slam.launch', 'open_rviz:=false'])
         wait_until(lambda: 'tb3_slam parameters' in slam.output(None), READY_TIMEOUT, 'SLAM node',
                    watch=(sim, slam))
-        slam_pid = _node_pid('/tb3_slam')
+        nodes = ('/tb3_slam', '/tb3_sim', '/robot_state_publisher')
+        wait_until(lambda: None not in [node_pid(name) for name in nodes], READY_TIMEOUT, ', '.join(nodes),
+                   poll=0.1, watch=(sim, slam))
         path_file = os.path.join(log_dir, 'route_%g.json' % factor)
         say('mapping at factor %g: driving the %s route' % (factor, route))
-        wall_start, cpu_start = time.monotonic(), cpu_seconds(slam_pid)
+        wall_start = time.monotonic()
+        meter = CpuMeter([(name[1:], node_pid(name)) for name in nodes] + [('master', master_pid(master_uri))])
         driver = spawn('driver', ['python3', '-m', 'tb3_harness.route_driver', route, '--out', path_file])
         wait_until(lambda: not driver.running(), ROUTE_TIMEOUT, 'end of the route', watch=(sim, slam))
         wall = time.monotonic() - wall_start
-        slam_cpu = (cpu_seconds(slam_pid) - cpu_start) / wall
+        cpu = meter.shares(wall)
         if driver.popen.returncode != 0:
             raise RunError('the route driver ended with code %s: %s' % (driver.popen.returncode, tail(driver.log)))
         with open(path_file) as stream:
@@ -108,7 +108,7 @@ def map_world(log_dir, output, factor=0.0, profile='realistic', seed=7, world='t
     quality = measure(saved.grid, saved.values, obstacles, start[:2])
     if not paths['map']:
         raise RunError('no pose in the map frame was ever recorded: %s' % tail(slam.log))
-    return MappingRun(factor, paths['truth'], paths['odom'], paths['map'], paths['sim_seconds'], wall, slam_cpu,
+    return MappingRun(factor, paths['truth'], paths['odom'], paths['map'], paths['sim_seconds'], wall, cpu,
                       map_name + '.yaml', quality, _error(paths['map'][-1], paths['truth'][-1]),
                       _error(paths['odom'][-1], paths['truth'][-1]), saved.grid, saved.values)
 

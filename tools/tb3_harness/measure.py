@@ -37,6 +37,37 @@ def cpu_seconds(pid):
     return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
 
 
+def node_pid(name):
+    """PID of the node `name`, from its own XML-RPC API (as `rosnode info` finds it); None while the
+    master does not know it or the node it knows does not answer (one of that name that ended)."""
+    import rosgraph
+    try:
+        uri = rosgraph.Master('/tb3_harness').lookupNode(name)
+        return xmlrpc.client.ServerProxy(uri).getPid('/tb3_harness')[2]
+    except (rosgraph.MasterError, OSError):
+        return None
+
+
+class CpuMeter(object):
+    """CPU time of named processes from a start on: the nodes of a run and the master, which also
+    works for them (each parameter a node reads at run time is an XML-RPC call to it)."""
+
+    def __init__(self, pids):
+        """`pids`: {label: pid}, in the order the rows are to be printed."""
+        self.pids = dict(pids)
+        self._start = dict((label, cpu_seconds(pid)) for label, pid in self.pids.items())
+
+    def shares(self, wall):
+        """{label: share of a core} over `wall` s since the start (nan for a process that ended)."""
+        used = {}
+        for label, pid in self.pids.items():
+            try:
+                used[label] = (cpu_seconds(pid) - self._start[label]) / wall
+            except OSError:
+                used[label] = float('nan')
+        return used
+
+
 def memory_mib(pid, field='VmHWM'):
     """A memory figure of /proc/PID/status in MiB: VmHWM (peak RSS) or VmRSS (now)."""
     with open('/proc/%d/status' % pid) as status:

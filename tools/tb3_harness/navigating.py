@@ -215,7 +215,7 @@ HOUSE_GOALS = [(-6.5, -1.5, -math.pi / 2), (1.0, 3.0, math.pi / 2), (4.0, 1.0, 0
 @dataclasses.dataclass
 class NavigationRun(object):
     """One run of the navigation chapter: each goal's Outcome, the map, the recordings, and what it cost
-    (CPU shares of a core: amcl and move_base together, the simulator; wall and sim seconds of the goals)."""
+    (CPU shares of a core of each process; wall and sim seconds of the goals)."""
     factor: float
     world: str
     map_file: str
@@ -226,12 +226,16 @@ class NavigationRun(object):
     plans: list
     clouds: list
     spreads: list
-    stack_cpu: float
-    sim_cpu: float
+    cpu: dict  # {process: share of a core} while it drove to the goals: amcl, move_base, the simulator ...
     wall_seconds: float
     sim_seconds: float
     clearance: float
     closest: tuple  # the true pose [t, x, y, yaw] where the footprint came closest
+
+    @property
+    def stack_cpu(self):
+        """The share of a core amcl and move_base used together."""
+        return self.cpu['amcl'] + self.cpu['move_base']
 
 
 @contextlib.contextmanager
@@ -276,8 +280,8 @@ def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD
     from tb3_common.map_files import load_map
     from tb3_sim_nav.world_file import load_world
 
-    from .mapping import _node_pid
-    from .measure import cpu_seconds
+    from .measure import CpuMeter, node_pid
+    from .processes import master_pid
     rosgraph.Master('/tb3_harness').setParam('/tb3_sim/seed', seed)
     rosgraph.Master('/tb3_harness').setParam('/amcl/seed', seed)
     package = rospkg.RosPack().get_path('tb3_sim_nav')
@@ -285,8 +289,9 @@ def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD
     with running(log_dir, ['tb3_sim_bringup', launch, 'profile:=%s' % profile, 'real_time_factor:=%g' % factor],
                  ['tb3_sim_bringup', 'tb3_navigation.launch', 'open_rviz:=false', 'map_file:=%s' % map_file],
                  spawn) as navigation:
-        pids = [_node_pid(name) for name in ('/amcl', '/move_base', '/tb3_sim')]
-        cpu = [cpu_seconds(pid) for pid in pids]
+        meter = CpuMeter([(name[1:], node_pid(name)) for name in ('/amcl', '/move_base', '/tb3_sim',
+                                                                   '/robot_state_publisher')]
+                         + [('master', master_pid(os.environ['ROS_MASTER_URI']))])
         wall, sim = time.monotonic(), rospy.get_time()
         outcomes = []
         for goal in goals:
@@ -294,13 +299,13 @@ def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD
             say_goal(len(outcomes) + 1, outcome)
             outcomes.append(outcome)
         wall, sim = time.monotonic() - wall, rospy.get_time() - sim
-        used = [cpu_seconds(pid) - before for pid, before in zip(pids, cpu)]
+        cpu = meter.shares(wall)
     saved = load_map(map_file)
     obstacles = load_world(world, os.path.join(package, 'worlds')).obstacles
     truth = list(navigation.truth)
     return NavigationRun(factor, world, map_file, outcomes, saved.grid, saved.values, truth, list(navigation.plans),
-                         list(navigation.clouds), list(navigation.spreads), (used[0] + used[1]) / wall,
-                         used[2] / wall, wall, sim, *closest(truth, obstacles, BURGER_FOOTPRINT))
+                         list(navigation.clouds), list(navigation.spreads), cpu, wall, sim,
+                         *closest(truth, obstacles, BURGER_FOOTPRINT))
 
 
 def say_goal(number, outcome):
@@ -324,7 +329,7 @@ def table(run):
     lines += ['  footprint never nearer than %.3f m to a pillar or wall (at %.1f s: x %.2f, y %.2f, yaw %.2f)'
               % ((run.clearance,) + tuple(run.closest)),
               '  %.1f s of sim time in %.1f s wall; amcl and move_base %.0f %% of a core, the simulator %.0f %%'
-              % (run.sim_seconds, run.wall_seconds, 100 * run.stack_cpu, 100 * run.sim_cpu)]
+              % (run.sim_seconds, run.wall_seconds, 100 * run.stack_cpu, 100 * run.cpu['tb3_sim'])]
     return lines
 
 
