@@ -8,7 +8,7 @@ simulator's figures are measured in bench_sim.py, the cameras' in
 bench_camera.py, the maps' and navigation's by the harness (mapping.py,
 navigating.py).
 
-    python3 tools/bench.py [--runs N] [--parts rtf,cpu,floor,camera,scripts,nav]
+    python3 tools/bench.py [--runs N] [--parts rtf,cpu,floor,camera,scripts,nav,explore]
 """
 import argparse
 import datetime
@@ -31,7 +31,7 @@ from bench_sim import (
 )
 
 from tb3_common.pose2d import normalize_angle
-from tb3_harness import leftovers, mapping, navigating, tutorial
+from tb3_harness import exploring, leftovers, mapping, navigating, tutorial
 from tb3_harness.measure import machine
 from tb3_harness.processes import RunError, say, start_master
 
@@ -42,6 +42,50 @@ def cpu_rows(runs):
     """A row for each process of the runs at factors 1 and 0 (the same processes): its share of a core."""
     return ['%-58s %5.1f / %.1f %%' % ('    %s' % name, 100 * runs[1.0].cpu[name], 100 * runs[0.0].cpu[name])
             for name in runs[1.0].cpu]
+
+
+def strict(run):
+    """The MapQuality of an exploration's map with issue 31's tolerance, 0.05 m (the harness's is 0.10)."""
+    import rospkg
+
+    from tb3_harness.map_quality import QualityConfig, measure
+    from tb3_sim_nav import world_map
+    from tb3_sim_nav.world_file import load_world
+    obstacles = load_world(run.world, os.path.join(rospkg.RosPack().get_path('tb3_sim_nav'), 'worlds')).obstacles
+    start = exploring.WORLDS[run.world][1]
+    return measure(run.grid, run.values, obstacles, start, QualityConfig(tolerance=0.05),
+                   bounds=world_map.bounds(world_map.in_plane(obstacles)))
+
+
+def explore_rows(explored, navigated):
+    """The house explored as fast as possible with and without explore_bounds, then its four rooms
+    navigated on the first map (what `make demo DEMO_ARGS=--explore` does)."""
+    lines = ['turtlebot3_house explored (tb3_slam.launch explore:=true, profile realistic), factor 0, one run each:']
+    for label, run in explored.items():
+        quality = run.quality
+        lines += ['  %s:' % label,
+                  '%-58s %12s' % ('    goals sent, blacklisted', '%d, %d' % (run.goals, run.blacklisted)),
+                  '%-58s %5.0f s / %.0f s' % ('    sim / wall time (the launches included)', run.sim_seconds,
+                                              run.wall_seconds),
+                  '%-58s %12.1f' % ('    real-time factor', run.sim_seconds / run.wall_seconds),
+                  '%-58s %5.1f / %.1f %%' % ('    occupied cells within 0.05 / 0.10 m of a surface',
+                                             100 * strict(run).occupied_near_surface,
+                                             100 * quality.occupied_near_surface),
+                  '%-58s %11.1f%%' % ('    surfaces covered', 100 * quality.surface_covered),
+                  '%-58s %11.1f%%' % ('    walls drawn twice (surface points)', 100 * quality.doubled_wall_share),
+                  '    CPU of each process while exploring:']
+        lines += ['%-58s %11.1f%%' % ('      %s' % name, 100 * share) for name, share in run.cpu.items()]
+    first = next(iter(explored.values()))
+    reached = sum(o.state == 'SUCCEEDED' for o in navigated.outcomes)
+    lines += ['  its four rooms navigated on the first map (amcl, move_base):',
+              '%-58s %12s' % ('    goals reached, worst true distance', '%d/%d, %.1f cm' % (
+                  reached, len(navigated.outcomes), 100 * max(o.xy_error for o in navigated.outcomes))),
+              '%-58s %5.0f s / %.0f s' % ('    sim / wall time of the goals', navigated.sim_seconds,
+                                          navigated.wall_seconds),
+              '%-58s %10.0f s  <= 120 s: %s' % ('  exploring (launches included) and the goals, wall time',
+                                                first.wall_seconds + navigated.wall_seconds,
+                                                verdict(first.wall_seconds + navigated.wall_seconds <= 120))]
+    return lines
 
 
 def nav_rows(mapped, navigated):
@@ -80,7 +124,8 @@ def main(argv=None):
                              'floor (CPU of a bare /clock loop, for scale), camera (frame costs, real time '
                              'with a camera read), scripts (the tutorial scripts at factor 1 and 0), nav (the '
                              'SLAM and the navigation stack at factor 1 and as fast as possible, once each); '
-                             'default all')
+                             'default all; explore (turtlebot3_house explored with and without explore_bounds, '
+                             'its rooms navigated: about 20 minutes) only when named')
     parser.add_argument('--output', default=os.path.join(ROOT, 'bench_output'))
     args = parser.parse_args(argv)
     log_dir = os.path.join(args.output, 'logs')
@@ -133,6 +178,21 @@ def main(argv=None):
                 % (factor, navigated[factor].sim_seconds, navigated[factor].wall_seconds,
                    100 * navigated[factor].stack_cpu))
 
+        explored, house = {}, None
+        if 'explore' in parts:
+            launch, start, bounded = exploring.WORLDS['turtlebot3_house']
+            for label, slam_args in (('with explore_bounds (the demo)', bounded), ('without explore_bounds', ())):
+                folder = os.path.join(args.output, 'house_%s' % ('bounded' if slam_args else 'unbounded'))
+                os.makedirs(folder, exist_ok=True)
+                explored[label] = exploring.explore_world(
+                    log_dir, folder, 'turtlebot3_house', launch, start, factor=0.0, timeout=3600.0,
+                    slam_command=exploring.SLAM_COMMAND + list(slam_args))
+                say('turtlebot3_house %s: %s' % (label, explored[label].summary()))
+                if house is None:
+                    house = navigating.navigate_world(log_dir, factor=0.0, world='turtlebot3_house',
+                                                      launch=launch, map_file=explored[label].map_yaml,
+                                                      goals=navigating.HOUSE_GOALS, spawn=navigating.HOUSE_SPAWN)
+
         lines += ['tb3_sim_nav benchmark, %s' % datetime.date.today().isoformat(),
                   'machine: %s' % machine(),
                   'medians of %d runs; real-time factor = sim seconds per wall second' % args.runs, '',
@@ -175,6 +235,8 @@ def main(argv=None):
                          end_1[1], end_1[2], math.degrees(end_1[3]), end_0[1], end_0[2], math.degrees(end_0[3]))]
         if mapped:
             lines += nav_rows(mapped, navigated)
+        if explored:
+            lines += explore_rows(explored, house)
     except RunError as error:
         print('bench FAILED: %s' % error, file=sys.stderr)
         return 1

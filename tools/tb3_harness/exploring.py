@@ -20,6 +20,7 @@ import re
 import time
 
 from .map_quality import measure
+from .measure import CpuMeter, node_pid
 from .navigating import clearance
 from .processes import Process, RunError, master_pid, say, tail, wait_until
 
@@ -48,6 +49,7 @@ class ExplorationRun(object):
     map_yaml: str
     quality: object          # map_quality.MapQuality
     clearance: float
+    cpu: dict                # {process: share of a core} from the explorer's start to its end
     grid: object = None
     values: object = None
 
@@ -111,6 +113,10 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
                    watch=(sim, slam, recorder))
         say('exploring %s at factor %g' % (world, factor))
         told, shown = time.monotonic(), 0
+        meter = CpuMeter([(name[1:], node_pid(name)) for name in ('/tb3_slam', '/move_base', '/explore', '/tb3_sim',
+                                                                   '/robot_state_publisher')]
+                         + [('master', master_pid(master_uri))])
+        meter_start = time.monotonic()
 
         def done():
             nonlocal told, shown
@@ -127,6 +133,7 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
         wait_until(done, timeout, 'end of the exploration ("exploration done" in %s)' % slam.log, poll=1.0,
                    watch=(sim, slam, recorder))
         wall = time.monotonic() - wall_start
+        cpu = meter.shares(time.monotonic() - meter_start)
         match = progress(_read(slam.log))[2]
         saver = spawn('map_saver', ['rosrun', 'map_server', 'map_saver', '-f', map_name])
         if saver.wait(SAVE_TIMEOUT) != 0:
@@ -146,7 +153,7 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
                       bounds=world_map.bounds(world_map.in_plane(obstacles)))
     return ExplorationRun(world, factor, match.group(2), int(match.group(6)), int(match.group(8)),
                           float(match.group(7)), wall, truth, map_name + '.yaml', quality,
-                          clearance(truth, obstacles, BURGER_FOOTPRINT), saved.grid, saved.values)
+                          clearance(truth, obstacles, BURGER_FOOTPRINT), cpu, saved.grid, saved.values)
 
 
 #: The worlds explored from their launch's spawn pose: launch, spawn (x, y), the SLAM's launch args.

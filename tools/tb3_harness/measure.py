@@ -53,8 +53,9 @@ class CpuMeter(object):
     works for them (each parameter a node reads at run time is an XML-RPC call to it)."""
 
     def __init__(self, pids):
-        """`pids`: {label: pid}, in the order the rows are to be printed."""
-        self.pids = dict(pids)
+        """`pids`: (label, pid) pairs in the order the rows are to be printed; a pid None (a node
+        not running) is left out."""
+        self.pids = dict((label, pid) for label, pid in pids if pid is not None)
         self._start = dict((label, cpu_seconds(pid)) for label, pid in self.pids.items())
 
     def shares(self, wall):
