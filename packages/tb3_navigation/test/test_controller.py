@@ -12,7 +12,7 @@ from tb3_harness.nav_sim import Lidar, Unicycle, costmaps, footprint_clearance, 
 from tb3_navigation.controller import STALLED, Command, DwaConfig, DwaController, dwa_config
 from tb3_navigation.costmap import BURGER_FOOTPRINT, Costmap, CostmapConfig
 from tb3_navigation.planner import GlobalPlanner
-from tb3_navigation.trajectory_scoring import velocity_samples
+from tb3_navigation.trajectory_scoring import _densify, velocity_samples
 
 PERIOD = 0.1  # s: controller_frequency 10
 CLEARANCE = 0.09  # m: the footprint never nearer to an obstacle
@@ -255,3 +255,20 @@ def test_without_forward_point_scoring_the_turn_in_place_faces_the_goal():
         plan = straight_plan(1.0, side * 2.5)
         command = controller.compute((0.0, 0.0, 0.0), (0.0, 0.0), plan)
         assert command.ok and command.v == 0.0 and math.copysign(1.0, command.w) == side
+
+
+def test_the_plan_is_densified_as_map_grid_does_it():
+    """MapGrid::adjustPlanResolution: every point of the plan kept as it is and in order, points
+    inserted evenly on each segment longer than the resolution, none left more than it apart."""
+    plan = np.array([[0.0, 0.0], [0.05, 0.0], [0.05, 0.0], [0.3, 0.1], [0.32, 0.1], [0.32, -0.5]])
+    dense = _densify(plan, 0.05)
+    gaps = np.hypot(*np.diff(dense, axis=0).T)
+    assert gaps.max() <= 0.05 + 1e-12
+    kept = [int(np.flatnonzero((dense == point).all(axis=1))[-1]) for point in plan[[0, 1, 3, 4, 5]]]
+    assert kept == sorted(kept) and kept[0] == 0 and kept[-1] == len(dense) - 1
+    # 0.269 m from (0.05, 0) to (0.3, 0.1): ceil(5.39) = 6 steps, 5 points between at k / 6 of it.
+    between = dense[kept[1] + 1:kept[2]]  # kept[1]: the second of the two equal points
+    assert len(between) == 5
+    assert between == pytest.approx(np.array([0.05, 0.0]) + np.outer(np.arange(1, 6) / 6.0, [0.25, 0.1]))
+    assert len(dense) == 1 + 1 + 1 + 6 + 1 + 12  # the points, and 5 + 11 inserted
+    assert _densify(plan[:1], 0.05).tolist() == [[0.0, 0.0]]

@@ -176,17 +176,20 @@ class TrajectoryScorer(object):
 
 
 def _densify(points, resolution):
-    """MapGrid::adjustPlanResolution: points inserted so that none is more than `resolution` from the next."""
+    """MapGrid::adjustPlanResolution: points inserted so that none is more than `resolution` from the next
+    (a segment `steps` long gets steps - 1, at k / steps of it; its end point kept as it is)."""
+    points = np.asarray(points, dtype=float)
     if len(points) < 2:
-        return np.asarray(points, dtype=float)
-    out = [points[:1]]
-    for last, point in zip(points[:-1], points[1:]):
-        gap = math.hypot(*(point - last))
-        if gap > resolution:
-            steps = int(math.ceil(gap / resolution))
-            out.append(last + (point - last) * (np.arange(1, steps) / float(steps))[:, None])
-        out.append(point[None, :])
-    return np.concatenate(out)
+        return points
+    deltas = points[1:] - points[:-1]
+    gaps = np.fromiter(map(math.hypot, deltas[:, 0], deltas[:, 1]), float, len(deltas))
+    steps = np.where(gaps > resolution, np.ceil(gaps / resolution), 1.0).astype(np.intp)
+    segment = np.repeat(np.arange(len(deltas)), steps)
+    k = np.arange(len(segment)) - np.repeat(np.cumsum(steps) - steps, steps) + 1  # 1 .. steps of its segment
+    out = points[segment] + deltas[segment] * (k / steps[segment])[:, None]
+    ends = k == steps[segment]
+    out[ends] = points[1:]
+    return np.concatenate((points[:1], out))
 
 
 def _plan_cells(costmap, points):
