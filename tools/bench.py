@@ -46,15 +46,8 @@ def cpu_rows(runs):
 
 def strict(run):
     """The MapQuality of an exploration's map with issue 31's tolerance, 0.05 m (the harness's is 0.10)."""
-    import rospkg
-
-    from tb3_harness.map_quality import QualityConfig, measure
-    from tb3_sim_nav import world_map
-    from tb3_sim_nav.world_file import load_world
-    obstacles = load_world(run.world, os.path.join(rospkg.RosPack().get_path('tb3_sim_nav'), 'worlds')).obstacles
-    start = exploring.WORLDS[run.world][1]
-    return measure(run.grid, run.values, obstacles, start, QualityConfig(tolerance=0.05),
-                   bounds=world_map.bounds(world_map.in_plane(obstacles)))
+    from tb3_harness.map_quality import QualityConfig
+    return run.measured(QualityConfig(tolerance=0.05))
 
 
 def explore_rows(explored, navigated):

@@ -19,7 +19,7 @@ import os
 import re
 import time
 
-from .map_quality import measure
+from .map_quality import QualityConfig, measure
 from .measure import CpuMeter, node_pid
 from .navigating import clearance
 from .processes import Process, RunError, master_pid, say, tail, wait_until
@@ -52,6 +52,14 @@ class ExplorationRun(object):
     cpu: dict                # {process: share of a core} from the explorer's start to its end
     grid: object = None
     values: object = None
+    start: tuple = None      # the spawn (x, y)
+    obstacles: list = None   # the world's (world_file.load_world)
+
+    def measured(self, config=QualityConfig()):
+        """The map's MapQuality (map_quality.measure) under `config` (the harness's tolerance by default)."""
+        from tb3_sim_nav import world_map
+        return measure(self.grid, self.values, self.obstacles, self.start, config,
+                       bounds=world_map.bounds(world_map.in_plane(self.obstacles)))
 
     def summary(self):
         return ('%s explored in %.1f s of sim time (%.1f s wall at factor %g): %d goals, %d blacklisted; %s; '
@@ -89,7 +97,6 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
     import rospkg
 
     from tb3_common.map_files import load_map
-    from tb3_sim_nav import world_map
     from tb3_sim_nav.world_file import load_world
     master_uri = os.environ['ROS_MASTER_URI']
     if master_pid(master_uri) is None:
@@ -116,7 +123,6 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
         meter = CpuMeter([(name[1:], node_pid(name)) for name in ('/tb3_slam', '/move_base', '/explore', '/tb3_sim',
                                                                    '/robot_state_publisher')]
                          + [('master', master_pid(master_uri))])
-        meter_start = time.monotonic()
 
         def done():
             nonlocal told, shown
@@ -133,7 +139,7 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
         wait_until(done, timeout, 'end of the exploration ("exploration done" in %s)' % slam.log, poll=1.0,
                    watch=(sim, slam, recorder))
         wall = time.monotonic() - wall_start
-        cpu = meter.shares(time.monotonic() - meter_start)
+        cpu = meter.shares()
         match = progress(_read(slam.log))[2]
         saver = spawn('map_saver', ['rosrun', 'map_server', 'map_saver', '-f', map_name])
         if saver.wait(SAVE_TIMEOUT) != 0:
@@ -149,11 +155,12 @@ def explore_world(log_dir, output, world='turtlebot3_world', launch='tb3_world.l
     saved = load_map(map_name + '.yaml')
     worlds = os.path.join(rospkg.RosPack().get_path('tb3_sim_nav'), 'worlds')
     obstacles = load_world(world, worlds).obstacles
-    quality = measure(saved.grid, saved.values, obstacles, start[:2],
-                      bounds=world_map.bounds(world_map.in_plane(obstacles)))
-    return ExplorationRun(world, factor, match.group(2), int(match.group(6)), int(match.group(8)),
-                          float(match.group(7)), wall, truth, map_name + '.yaml', quality,
-                          clearance(truth, obstacles, BURGER_FOOTPRINT), cpu, saved.grid, saved.values)
+    run = ExplorationRun(world, factor, match.group(2), int(match.group(6)), int(match.group(8)),
+                         float(match.group(7)), wall, truth, map_name + '.yaml', None,
+                         clearance(truth, obstacles, BURGER_FOOTPRINT), cpu, saved.grid, saved.values,
+                         tuple(start[:2]), obstacles)
+    run.quality = run.measured()
+    return run
 
 
 #: The worlds explored from their launch's spawn pose: launch, spawn (x, y), the SLAM's launch args.
@@ -181,16 +188,11 @@ def table(run):
 
 def draw(run, filename, navigation_path=None):
     """The saved map under the world's outline, with the true path (and a navigation's after it)."""
-    import rospkg
-
-    from tb3_sim_nav.world_file import load_world
-
     from .map_quality import render_png
-    worlds = os.path.join(rospkg.RosPack().get_path('tb3_sim_nav'), 'worlds')
     paths = {'exploration path': [p[1:3] for p in run.truth]}
     if navigation_path:
         paths['navigation path'] = [p[1:3] for p in navigation_path]
-    render_png(filename, run.grid, run.values, load_world(run.world, worlds).obstacles, paths=paths,
+    render_png(filename, run.grid, run.values, run.obstacles, paths=paths,
                title='%s explored alone: %.0f %% of the reachable free floor mapped, %.0f s of sim time, %d goals'
                      % (run.world, 100 * run.quality.free_floor_mapped, run.sim_seconds, run.goals))
 

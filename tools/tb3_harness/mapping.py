@@ -79,16 +79,20 @@ def map_world(log_dir, output, factor=0.0, profile='realistic', seed=7, world='t
         wait_until(lambda: 'tb3_slam parameters' in slam.output(None), READY_TIMEOUT, 'SLAM node',
                    watch=(sim, slam))
         nodes = ('/tb3_slam', '/tb3_sim', '/robot_state_publisher')
-        wait_until(lambda: None not in [node_pid(name) for name in nodes], READY_TIMEOUT, ', '.join(nodes),
-                   poll=0.1, watch=(sim, slam))
+        pids = {}
+
+        def found():
+            pids.update((name, node_pid(name)) for name in nodes if pids.get(name) is None)
+            return None not in pids.values()
+        wait_until(found, READY_TIMEOUT, ', '.join(nodes), poll=0.1, watch=(sim, slam))
         path_file = os.path.join(log_dir, 'route_%g.json' % factor)
         say('mapping at factor %g: driving the %s route' % (factor, route))
         wall_start = time.monotonic()
-        meter = CpuMeter([(name[1:], node_pid(name)) for name in nodes] + [('master', master_pid(master_uri))])
+        meter = CpuMeter([(name[1:], pids[name]) for name in nodes] + [('master', master_pid(master_uri))])
         driver = spawn('driver', ['python3', '-m', 'tb3_harness.route_driver', route, '--out', path_file])
         wait_until(lambda: not driver.running(), ROUTE_TIMEOUT, 'end of the route', watch=(sim, slam))
         wall = time.monotonic() - wall_start
-        cpu = meter.shares(wall)
+        cpu = meter.shares()
         if driver.popen.returncode != 0:
             raise RunError('the route driver ended with code %s: %s' % (driver.popen.returncode, tail(driver.log)))
         with open(path_file) as stream:

@@ -2,6 +2,7 @@
 tests."""
 import os
 import platform
+import time
 import xmlrpc.client
 
 
@@ -16,18 +17,23 @@ def machine():
                                             platform.python_version())
 
 
-def sim_uri():
-    """XML-RPC URI of the /tb3_sim node, or None while it is not registered."""
+def node_uri(name):
+    """XML-RPC URI of the node `name`, or None while the master does not know it."""
     import rosgraph
     try:
-        return rosgraph.Master('/tb3_bench').lookupNode('/tb3_sim')
+        return rosgraph.Master('/tb3_harness').lookupNode(name)
     except rosgraph.MasterException:
         return None
 
 
+def sim_uri():
+    """XML-RPC URI of the /tb3_sim node, or None while it is not registered."""
+    return node_uri('/tb3_sim')
+
+
 def sim_pid():
-    """PID of the /tb3_sim node, from its own XML-RPC API."""
-    return xmlrpc.client.ServerProxy(sim_uri()).getPid('/tb3_bench')[2]
+    """PID of the /tb3_sim node."""
+    return node_pid('/tb3_sim')
 
 
 def cpu_seconds(pid):
@@ -40,26 +46,29 @@ def cpu_seconds(pid):
 def node_pid(name):
     """PID of the node `name`, from its own XML-RPC API (as `rosnode info` finds it); None while the
     master does not know it or the node it knows does not answer (one of that name that ended)."""
-    import rosgraph
+    uri = node_uri(name)
+    if uri is None:
+        return None
     try:
-        uri = rosgraph.Master('/tb3_harness').lookupNode(name)
         return xmlrpc.client.ServerProxy(uri).getPid('/tb3_harness')[2]
-    except (rosgraph.MasterError, OSError):
+    except OSError:
         return None
 
 
 class CpuMeter(object):
-    """CPU time of named processes from a start on: the nodes of a run and the master, which also
-    works for them (each parameter a node reads at run time is an XML-RPC call to it)."""
+    """CPU time of named processes from its creation on: the nodes of a run and the master, which
+    also works for them (each parameter a node reads at run time is an XML-RPC call to it)."""
 
     def __init__(self, pids):
         """`pids`: (label, pid) pairs in the order the rows are to be printed; a pid None (a node
         not running) is left out."""
         self.pids = dict((label, pid) for label, pid in pids if pid is not None)
         self._start = dict((label, cpu_seconds(pid)) for label, pid in self.pids.items())
+        self._wall = time.monotonic()
 
-    def shares(self, wall):
-        """{label: share of a core} over `wall` s since the start (nan for a process that ended)."""
+    def shares(self):
+        """{label: share of a core} since the meter was made (nan for a process that ended)."""
+        wall = time.monotonic() - self._wall
         used = {}
         for label, pid in self.pids.items():
             try:

@@ -299,7 +299,7 @@ def navigate_world(log_dir, factor=0.0, profile='realistic', seed=7, goals=WORLD
             say_goal(len(outcomes) + 1, outcome)
             outcomes.append(outcome)
         wall, sim = time.monotonic() - wall, rospy.get_time() - sim
-        cpu = meter.shares(wall)
+        cpu = meter.shares()
     saved = load_map(map_file)
     obstacles = load_world(world, os.path.join(package, 'worlds')).obstacles
     truth = list(navigation.truth)
