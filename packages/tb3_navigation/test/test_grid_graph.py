@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from tb3_navigation.grid_graph import build, shortest_paths, step_counts
+from tb3_navigation.grid_graph import build, reweigh, shortest_paths, step_counts
 
 
 @pytest.mark.parametrize('seed', range(4))
@@ -24,3 +24,22 @@ def test_a_wall_with_one_gap_is_walked_round_and_a_closed_room_is_unreached():
     counts = step_counts(blocked, [0])
     assert counts[0, 2] == 2 and counts[0, 4] == 4 + 4 + 4   # down, across and up again
     assert counts[4, 6] == 4 + 6 and counts[0, 6] == np.inf and counts[0, 3] == np.inf
+
+
+@pytest.mark.parametrize('connectivity', (4, 8))
+def test_a_graph_mended_where_costs_changed_has_the_weights_of_one_built_anew(connectivity):
+    rng = np.random.default_rng(connectivity)
+    shape = (23, 31)
+    steps = np.where(rng.random(shape) < 0.2, np.inf, rng.uniform(50, 250, shape))
+    heuristic = 50 * rng.random(shape)  # any values: the weights' formula is what is compared
+    for estimate in (None, heuristic):
+        graph = build(steps, connectivity, estimate)
+        mended = steps.copy()
+        for _ in range(20):
+            cells = rng.choice(steps.size, rng.integers(1, 40), replace=False)
+            mended.ravel()[cells] = np.where(rng.random(len(cells)) < 0.3, np.inf,
+                                             rng.uniform(50, 250, len(cells)))
+            reweigh(graph, mended, cells, connectivity, estimate)
+            fresh = build(mended, connectivity, estimate)
+            assert np.array_equal(graph.data, fresh.data)
+            assert np.array_equal(graph.indices, fresh.indices) and np.array_equal(graph.indptr, fresh.indptr)

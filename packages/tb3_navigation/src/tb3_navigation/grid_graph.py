@@ -10,7 +10,9 @@ with step_counts, a breadth-first search.
 
 The edges' layout depends on the grid's shape only, so it is built once per
 shape and kept; a graph then costs one pass of numpy over the edges (11 ms
-for 400 x 260 cells, 0.83 M edges). scipy's Dijkstra has no A*, but A* is
+for 400 x 260 cells, 0.83 M edges), and `reweigh` mends one in place where
+some cells' costs changed (a global costmap's update changes a few hundred
+of them: the same walls seen again, a frontier's new floor). scipy's Dijkstra has no A*, but A* is
 Dijkstra over edges reweighted by a consistent heuristic h (w + h(target) -
 h(source) >= 0), which `build` makes given h; a search over it bounded by
 `limit` visits only the cells whose cost so far plus h stays within it.
@@ -56,6 +58,32 @@ def _edges(shape, connectivity):
             np.concatenate(sides, axis=1)[:, order], sources[order])
 
 
+@functools.lru_cache(maxsize=8)
+def _dependents(shape, connectivity):
+    """(indptr, edges): the edges whose weight depends on each cell's step cost, CSR-like by cell: those
+    into it and the diagonal ones passing beside it."""
+    _, targets, _, sides, _ = _edges(shape, connectivity)
+    edges = np.arange(len(targets), dtype=np.int32)
+    diagonal = sides[0] != targets
+    cells = np.concatenate((targets, sides[0][diagonal], sides[1][diagonal]))
+    owners = np.concatenate((edges, edges[diagonal], edges[diagonal]))
+    order = np.argsort(cells, kind='stable')
+    return np.searchsorted(cells[order], np.arange(shape[0] * shape[1] + 1)), owners[order]
+
+
+def _weights(flat, edges, connectivity, shape, heuristic):
+    """The weights of `edges` (indices, or a slice) of a graph over cells of step costs `flat`."""
+    _, targets, lengths, sides, sources = _edges(shape, connectivity)
+    targets, lengths, sides = targets[edges], lengths[edges], sides[:, edges]
+    weights = flat[targets] * lengths
+    if heuristic is not None:
+        estimate = np.asarray(heuristic, dtype=float).ravel()
+        weights = np.maximum(weights + estimate[targets] - estimate[sources[edges]], 0.0)
+    enterable = np.isfinite(flat)
+    weights[~(enterable[sides[0]] & enterable[sides[1]])] = np.inf
+    return weights
+
+
 def build(step_costs, connectivity=8, heuristic=None):
     """The graph (scipy CSR, cells as nodes) of a grid whose cells cost `step_costs`
     (H, W) to step into. A diagonal step needs both cells it passes between to be
@@ -64,17 +92,26 @@ def build(step_costs, connectivity=8, heuristic=None):
     each cell, the weights are A*'s: w + h(target) - h(source), rounding errors
     clipped at 0."""
     step_costs = np.asarray(step_costs, dtype=float)
-    indptr, targets, lengths, sides, sources = _edges(step_costs.shape, connectivity)
+    indptr, targets = _edges(step_costs.shape, connectivity)[:2]
     flat = step_costs.ravel()
-    weights = flat[targets] * lengths
-    if heuristic is not None:
-        estimate = np.asarray(heuristic, dtype=float).ravel()
-        weights = np.maximum(weights + estimate[targets] - estimate[sources], 0.0)
-    enterable = np.isfinite(flat)
-    weights[~(enterable[sides[0]] & enterable[sides[1]])] = np.inf
+    weights = _weights(flat, slice(None), connectivity, step_costs.shape, heuristic)
     graph = csr_matrix((weights, targets, indptr), shape=(flat.size, flat.size))
     graph.has_sorted_indices = True
     return graph
+
+
+def reweigh(graph, step_costs, cells, connectivity=8, heuristic=None):
+    """Mends in place a graph `build` made, for the step costs (H, W) it holds now, of which only
+    the `cells` (flat indices) changed: the same weights as build(step_costs, connectivity, heuristic)."""
+    step_costs = np.asarray(step_costs, dtype=float)
+    indptr, owners = _dependents(step_costs.shape, connectivity)
+    cells = np.asarray(cells, dtype=np.intp).ravel()
+    starts, ends = indptr[cells], indptr[cells + 1]
+    counts = ends - starts
+    # Every owner between each cell's start and end, in one gather.
+    positions = np.repeat(starts - np.concatenate(([0], np.cumsum(counts)[:-1])), counts) + np.arange(counts.sum())
+    edges = np.unique(owners[positions])
+    graph.data[edges] = _weights(step_costs.ravel(), edges, connectivity, step_costs.shape, heuristic)
 
 
 def shortest_paths(graph, shape, sources, limit=np.inf):
