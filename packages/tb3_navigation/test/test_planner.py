@@ -231,3 +231,31 @@ def test_orientation_modes_as_global_planners_orientation_filter():
     # Forward, then from the third last pose back to the last turn of more than 0.35 rad, interpolated to
     # the goal's heading (here the turn is at the third last pose itself).
     assert yaws(3, start_yaw=-0.6) == pytest.approx([-0.6, 0.0, math.pi / 2, (math.pi / 2 + 1.0) / 2, 1.0])
+
+
+def test_replans_bounded_by_the_last_plan_are_as_cheap_as_plans_from_scratch(world, monkeypatch):
+    """A replan to the same goal bounds its search by what the rest of the last plan costs now: from
+    points along it, a cell off it, and after a wall across it (the bound is gone: searched as
+    at first), the plan costs what a new planner's costs."""
+    obstacles, costmap = world
+    goal = (1.6, 0.6, 0.0)
+    planner = GlobalPlanner()
+    plan = np.array(planner.make_plan(costmap, (-1.7, -0.5, 0.0), goal))
+    resolution = costmap.grid.resolution
+    starts = [tuple(plan[5]), tuple(plan[20]), (plan[30][0], plan[30][1] + resolution, 0.0), tuple(plan[40])]
+    blocked = Costmap(costmap.grid, CostmapConfig(), static=np.asarray(costmap.static, dtype=np.int16) % 256)
+    ahead = plan[(40 + len(plan)) // 2]  # between the last start and the goal
+    cells = blocked.grid.to_cells(np.array([ahead[:2]]))[0]
+    blocked.static[max(0, cells[1] - 30):cells[1] + 30, cells[0]] = 254  # a wall across the plan
+    blocked.update_costs()
+    limits, bound = [], GlobalPlanner._known_limit
+    monkeypatch.setattr(planner, '_known_limit', lambda *args: limits.append(bound(planner, *args)) or limits[-1])
+    for start, costs in [(start, costmap) for start in starts] + [(starts[-1], blocked)]:
+        replanned = planner.make_plan(costs, start, goal)
+        assert (limits[-1] is None) == (costs is blocked), limits  # bounded but when walled off
+        fresh = GlobalPlanner()
+        first = fresh.make_plan(costs, start, goal)
+        assert replanned is not None and first is not None
+        end = costs.grid.to_cells(np.array([goal[:2]]))[0]
+        assert planner.potential[end[1], end[0]] == pytest.approx(fresh.potential[end[1], end[0]], rel=1e-12)
+        assert len(replanned) == len(first)

@@ -154,6 +154,23 @@ def step_counts(blocked, sources):
     return np.where(reached[:cells], depth[:cells] - 1.0, np.inf).reshape(shape)
 
 
+def path_cost(graph, cells):
+    """The sum of `graph`'s weights along the path `cells` (flat indices, each a neighbour of the
+    one before): inf if a step is no edge of it or is blocked."""
+    cells = np.asarray(cells, dtype=np.intp)
+    if len(cells) < 2:
+        return 0.0
+    sources, targets = cells[:-1], cells[1:]
+    # A cell's edges lie side by side in the CSR arrays, at most 8 of them: look at each.
+    positions = graph.indptr[sources][:, None] + np.arange(8)
+    inside = positions < graph.indptr[sources + 1][:, None]
+    positions = np.minimum(positions, len(graph.indices) - 1)
+    match = inside & (graph.indices[positions] == targets[:, None])
+    if not match.any(axis=1).all():
+        return np.inf
+    return float(np.sum(graph.data[positions[match]]))
+
+
 def path_to(predecessors, target):
     """The flat indices of the cells from a source to `target` (both included),
     following `predecessors`; [target] alone if target is a source."""
