@@ -340,3 +340,33 @@ def test_inflation_changes_on_a_running_costmap_and_inflate_unknown():
     costmap.reconfigure(config.replace(inflate_unknown=True))
     assert FREE_SPACE < costmap.costs[40, 50] < INSCRIBED_INFLATED_OBSTACLE  # 0.5 m from the wall: inflated
     assert costmap.costs[40, 52] == NO_INFORMATION                          # 0.6 m, beyond 0.5 m: unknown
+
+
+def test_costs_are_inflated_again_only_when_the_layers_or_the_parameters_changed(monkeypatch):
+    """An update that leaves the combined layers as they were (no scan, the footprint already free;
+    the same scan again) keeps the costs; a new obstacle, a footprint on a mark and new inflation
+    parameters inflate anew, to the costs a new costmap with the same layers has."""
+    grid, data = empty_map()
+    costmap = Costmap(grid, CostmapConfig(), static=data)
+    inflated = []
+    inflate = Costmap._inflate
+    monkeypatch.setattr(costmap, '_inflate', lambda master: inflated.append(1) or inflate(costmap, master))
+
+    def fresh():
+        again = Costmap(grid, costmap.config, static=data)
+        again.obstacles = costmap.obstacles.copy()
+        again.update_costs()
+        return again.costs
+
+    pose, boxes = (0.0, 0.0, 0.0), [box(1.0, 0.3, 0.1, 0.4)]
+    scan = Lidar(boxes, 1).scan(pose)
+    for what, update, inflates in [
+            ('a scan marks the box', lambda: costmap.update(pose, scan, SCAN_POSE), True),
+            ('no scan, the footprint free', lambda: costmap.update(pose), False),
+            ('the same scan again', lambda: costmap.update(pose, scan, SCAN_POSE), False),
+            ('the footprint over a mark', lambda: costmap.update((0.95, 0.3, 0.0)), True),
+            ('a narrower inflation', lambda: costmap.reconfigure(CostmapConfig(inflation_radius=0.5)), True)]:
+        inflated.clear()
+        update()
+        assert bool(inflated) == inflates, what
+        assert np.array_equal(costmap.costs, fresh()), what

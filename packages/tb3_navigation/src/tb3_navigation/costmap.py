@@ -157,6 +157,7 @@ class Costmap(object):
 
     def _take(self, config):
         self.config = config
+        self._master = None  # the layers combined when the costs were last inflated (new parameters: none)
         self.footprint = config.padded_footprint
         self.inscribed_radius, self.circumscribed_radius = footprint_radii(self.footprint)
         self._outline = outline(self.footprint, self.grid.resolution / 2.0)
@@ -239,11 +240,17 @@ class Costmap(object):
                          (grid.origin[0] + sx * grid.resolution, grid.origin[1] + sy * grid.resolution, 0.0))
 
     def update_costs(self):
-        """The master: static overwritten, obstacles by maximum where known, then inflation."""
+        """The master: static overwritten, obstacles by maximum where known, then inflation, unless
+        the master is what it was (the costs are its and the parameters' alone): a global costmap
+        updated at 10 Hz gets a scan at 5 Hz, and a scan often marks and clears what it did before.
+        Inflating turtlebot3_house's 400 x 260 cells takes over a hundred times as long as combining them."""
         master = self.static.copy() if self.static is not None else np.full(self.grid.shape, self._default, np.uint8)
         known = self.obstacles != NO_INFORMATION
         take = known & ((master == NO_INFORMATION) | (master < self.obstacles))
         master[take] = self.obstacles[take]
+        if self._master is not None and np.array_equal(master, self._master):
+            return
+        self._master = master
         self.costs = self._inflate(master)
 
     def _inflate(self, master):
