@@ -370,3 +370,24 @@ def test_costs_are_inflated_again_only_when_the_layers_or_the_parameters_changed
         update()
         assert bool(inflated) == inflates, what
         assert np.array_equal(costmap.costs, fresh()), what
+
+
+@pytest.mark.parametrize('inflate_unknown', (False, True))
+def test_costs_inflated_again_round_what_changed_are_those_of_the_whole_map(inflate_unknown):
+    """Random layers changed in random boxes (marks, clearings, unknown cells, near the edges too):
+    the costs inflated round the change are, bitwise, those of a new costmap with the same layers."""
+    rng = np.random.default_rng(7)
+    config = CostmapConfig(inflate_unknown=inflate_unknown, inflation_radius=0.3, track_unknown_space=True)
+    grid = Grid(0.05, 70, 50, (0.0, 0.0, 0.0))
+    static = np.where(rng.random(grid.shape) < 0.02, 100, np.where(rng.random(grid.shape) < 0.1, -1, 0))
+    costmap = Costmap(grid, config, static=static.astype(np.int8))
+    for _ in range(60):
+        y, x = rng.integers(0, grid.height), rng.integers(0, grid.width)
+        size = rng.integers(1, 8, 2)
+        costmap.obstacles[y:y + size[0], x:x + size[1]] = rng.choice(
+            [FREE_SPACE, LETHAL_OBSTACLE, NO_INFORMATION], p=[0.5, 0.3, 0.2])
+        costmap.update_costs()
+        again = Costmap(grid, config, static=static.astype(np.int8))
+        again.obstacles = costmap.obstacles.copy()
+        again.update_costs()
+        assert np.array_equal(costmap.costs, again.costs)
