@@ -154,6 +154,11 @@ def step_counts(blocked, sources):
     return np.where(reached[:cells], depth[:cells] - 1.0, np.inf).reshape(shape)
 
 
+def neighbours(graph, cell):
+    """The flat indices of the cells `graph` has an edge to from `cell` (a flat index)."""
+    return graph.indices[graph.indptr[cell]:graph.indptr[cell + 1]]
+
+
 def path_cost(graph, cells):
     """The sum of `graph`'s weights along the path `cells` (flat indices, each a neighbour of the
     one before): inf if a step is no edge of it or is blocked."""

@@ -33,7 +33,7 @@ import numpy as np
 from tb3_common.params import Checked, fail, non_negative, number, parameter
 from tb3_common.pose2d import normalize_angle
 from tb3_navigation.costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION
-from tb3_navigation.grid_graph import UNREACHED, build, path_cost, path_to, reweigh, shortest_paths
+from tb3_navigation.grid_graph import UNREACHED, build, neighbours, path_cost, path_to, reweigh, shortest_paths
 
 COST_OBS = 254  # navfn: the step cost of a cell it must not enter (and one below: the dearest it may)
 #: Costs changed in more than 1 cell of this many: the graphs are built anew (mending a 16th of a
@@ -206,8 +206,7 @@ class GlobalPlanner(object):
         if len(on):
             rest = path_cost(graph, last[on[-1]:])
         else:  # a step off it: onto the nearest of its cells beside the robot's
-            neighbours = graph.indices[graph.indptr[start_index]:graph.indptr[start_index + 1]]
-            beside = np.flatnonzero(np.isin(last, neighbours))
+            beside = np.flatnonzero(np.isin(last, neighbours(graph, start_index)))
             if not len(beside):
                 return None
             rest = path_cost(graph, np.concatenate(([start_index], last[beside[-1]:])))
