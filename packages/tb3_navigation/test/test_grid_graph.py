@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from tb3_navigation.grid_graph import build, reweigh, shortest_paths, step_counts
+from tb3_navigation.grid_graph import build, reweigh, shortest_paths, step_counter, step_counts
 
 
 @pytest.mark.parametrize('seed', range(4))
@@ -15,6 +15,17 @@ def test_step_counts_are_dijkstras_distances_over_unit_steps_that_never_enter_a_
         sources = rng.integers(0, blocked.size, rng.integers(1, 12))
         expected, _ = shortest_paths(build(np.where(blocked, np.inf, 1.0), 4), shape, sources)
         assert np.array_equal(step_counts(blocked, sources), expected)
+
+
+def test_one_step_counter_counts_from_each_set_of_sources_as_a_new_one_would():
+    """The controller counts from the plan, the local goal and the point ahead on one counter."""
+    rng = np.random.default_rng(7)
+    blocked = rng.random((30, 40)) < 0.25
+    counter = step_counter(blocked)
+    for count in (25, 1, 1, 3, 25):
+        sources = rng.integers(0, blocked.size, count)
+        expected, _ = shortest_paths(build(np.where(blocked, np.inf, 1.0), 4), blocked.shape, sources)
+        assert np.array_equal(counter(sources), expected)
 
 
 def test_a_wall_with_one_gap_is_walked_round_and_a_closed_room_is_unreached():

@@ -130,28 +130,38 @@ def step_counts(blocked, sources):
     cell, never into a `blocked` one (a blocked source is left all the same); inf where none
     reaches: shortest_paths' distances over build(where(blocked, inf, 1), 4), by a breadth-first search
     from one node more, joined to every source (60 x 60 cells: 0.55 ms, Dijkstra 1.55 ms)."""
+    return step_counter(blocked)(sources)
+
+
+def step_counter(blocked):
+    """step_counts(blocked, sources) as a function of `sources`: the edges between open cells, half
+    the work of a count on a local costmap, are found once for the counts from several sources."""
     height, width = shape = np.shape(blocked)
     cells = height * width
     indptr, targets = _edges(shape, 4)[:2]
     kept = ~np.asarray(blocked, dtype=bool).ravel()[targets]
-    rows = np.empty(cells + 2, dtype=np.int32)
-    rows[0] = 0
-    np.cumsum(np.add.reduceat(kept, indptr[:-1], dtype=np.int32), out=rows[1:cells + 1])
-    sources = np.asarray(sources, dtype=np.int32).ravel()
-    rows[cells + 1] = rows[cells] + len(sources)
-    columns = np.concatenate((targets[kept], sources))
-    graph = csr_matrix((np.ones(len(columns)), columns, rows), shape=(cells + 1, cells + 1))
-    _, parents = breadth_first_order(graph, cells, directed=True, return_predecessors=True)
-    # Each cell's depth in the search's tree, by pointer jumping: every round adds the depth of
-    # the ancestor it points at and points twice as far up (7 rounds for 60 x 60 cells).
-    reached = parents >= 0
-    up = np.where(reached, parents, cells).astype(np.int32)
-    up[cells] = cells
-    depth = reached.astype(np.int32)
-    while (up != cells).any():
-        depth += depth[up]
-        up = up[up]
-    return np.where(reached[:cells], depth[:cells] - 1.0, np.inf).reshape(shape)
+    open_rows = np.empty(cells + 1, dtype=np.int32)
+    open_rows[0] = 0
+    np.cumsum(np.add.reduceat(kept, indptr[:-1], dtype=np.int32), out=open_rows[1:])
+    open_targets = targets[kept]
+
+    def counts(sources):
+        sources = np.asarray(sources, dtype=np.int32).ravel()
+        rows = np.append(open_rows, open_rows[-1] + len(sources)).astype(np.int32)
+        columns = np.concatenate((open_targets, sources))
+        graph = csr_matrix((np.ones(len(columns)), columns, rows), shape=(cells + 1, cells + 1))
+        _, parents = breadth_first_order(graph, cells, directed=True, return_predecessors=True)
+        # Each cell's depth in the search's tree, by pointer jumping: every round adds the depth of
+        # the ancestor it points at and points twice as far up (7 rounds for 60 x 60 cells).
+        reached = parents >= 0
+        up = np.where(reached, parents, cells).astype(np.int32)
+        up[cells] = cells
+        depth = reached.astype(np.int32)
+        while (up != cells).any():
+            depth += depth[up]
+            up = up[up]
+        return np.where(reached[:cells], depth[:cells] - 1.0, np.inf).reshape(shape)
+    return counts
 
 
 def neighbours(graph, cell):

@@ -35,7 +35,7 @@ import math
 import numpy as np
 
 from tb3_navigation.costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION
-from tb3_navigation.grid_graph import step_counts
+from tb3_navigation.grid_graph import step_counter
 
 CHUNK = 64  # trajectories whose footprints are checked together
 CLOSE = 1e4  # added to a trajectory nearer to an obstacle than obstacle_clearance: more than any other term
@@ -90,8 +90,9 @@ class TrajectoryScorer(object):
         scale_goal = config.goal_distance_bias * grid.resolution
         cells = _plan_cells(costmap, dense)
         ahead = config.forward_point_scoring  # false: TrajectoryPlannerROS's critics, the end point alone
-        return dict(path=_steps_from(blocked, cells), goal=_steps_from(blocked, cells[-1:]),
-                    front=_steps_from(blocked, _plan_cells(costmap, front)[-1:]) if ahead else None,
+        counts = step_counter(blocked)
+        return dict(path=_steps_from(counts, blocked, cells), goal=_steps_from(counts, blocked, cells[-1:]),
+                    front=_steps_from(counts, blocked, _plan_cells(costmap, front)[-1:]) if ahead else None,
                     scale_path=scale_path, scale_goal=scale_goal, scale_front=scale_goal if ahead else 0.0,
                     scale_alignment=0.0 if near_goal or not ahead else scale_path)
 
@@ -207,13 +208,13 @@ def _plan_cells(costmap, points):
     return cells[:, 1] * grid.width + cells[:, 0]
 
 
-def _steps_from(blocked, sources):
-    """4-neighbour step counts (H, W) from the nearest source around blocked cells;
-    blocked cells count H * W (MapGrid's obstacleCosts), unreached ones H * W + 1."""
+def _steps_from(counts, blocked, sources):
+    """4-neighbour step counts (H, W) from the nearest source around blocked cells (`counts`, a
+    step_counter of them); blocked cells count H * W (MapGrid's obstacleCosts), unreached ones H * W + 1."""
     size = blocked.size
     if not len(sources):
         return np.full(blocked.shape, size + 1.0)
-    distances = step_counts(blocked, sources)
+    distances = counts(sources)
     distances[blocked] = np.where(np.isfinite(distances[blocked]), distances[blocked], size)
     return np.where(np.isfinite(distances), distances, size + 1.0)
 
