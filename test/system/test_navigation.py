@@ -115,7 +115,8 @@ def test_a_box_spawned_on_the_way_is_driven_around(navigation):
         model_name='box_in_the_way', model_xml=BOX_SDF, robot_namespace='', initial_pose=pose, reference_frame='world')
     assert spawned.success, spawned.status_message
     outcome = navigation.go(1.65, -1.65, 0.0)
-    least, where = closest(outcome.path, world_obstacles(), BURGER_FOOTPRINT)
+    obstacles = world_obstacles()
+    least, where = closest(outcome.path, obstacles, BURGER_FOOTPRINT)
     from_box = clearance(outcome.path, [box_obstacle()], BURGER_FOOTPRINT)
     print('MEASURED past the box: %s in %.1f s of sim time, %.3f m off; footprint at least %.3f m from the world '
           '(at x %.3f, y %.3f, yaw %.2f, %.1f s), %.3f m from the box'
@@ -129,7 +130,7 @@ def test_a_box_spawned_on_the_way_is_driven_around(navigation):
     # goal before left it, within xy_goal_tolerance (0.05 m) of a point 0.11 m from the wall: the way
     # may come no nearer to the world than CLEARANCE or than that start (once, 2.5 cm towards the
     # wall: 0.083 m there, nearer than anywhere after).
-    at_start = clearance(outcome.path[:1], world_obstacles(), BURGER_FOOTPRINT)
+    at_start = clearance(outcome.path[:1], obstacles, BURGER_FOOTPRINT)
     assert least >= min(CLEARANCE, at_start) and from_box >= BOX_CLEARANCE, (least, at_start, from_box)
 
 
