@@ -48,6 +48,7 @@ import math
 from collections import namedtuple
 
 import numpy as np
+from scipy import ndimage
 
 from tb3_common.pose2d import compose, inverse, normalize_angle
 from tb3_navigation import matcher
@@ -110,7 +111,7 @@ class Amcl(object):
         self.field = LikelihoodField(grid, values, config.laser_likelihood_max_dist)
         self.model = LikelihoodFieldModel(self.field, config.laser_z_hit, config.laser_z_rand, config.laser_sigma_hit)
         occupied = np.asarray(values).reshape(grid.shape) == 100
-        self._walls = (matcher.WallField.of_map(grid, occupied, REFINE_SIGMA, matcher.line_means(grid, occupied))
+        self._walls = (matcher.WallField.of_map(grid, occupied, REFINE_SIGMA, line_means(grid, occupied))
                        if config.refine_estimate and occupied.any() else None)
         self._points = None  # the last update's beam end points (base frame), for the refinement
         free = np.argwhere(np.asarray(values).reshape(grid.shape) == 0)  # amcl samples free cells only, not unknown
@@ -282,3 +283,34 @@ class Amcl(object):
         if self._odom is None:
             return None
         return tuple(float(value) for value in compose(self._estimate.pose, inverse(self._odom)))
+
+
+def line_means(grid, occupied, radius=3, flatness=0.1):
+    """Wall points for a map that keeps no hits (one loaded from a file): each occupied cell's
+    centre put on the line fitted (principal axis) through the occupied cells' centres within
+    `radius` cells of it, where those lie along a line (spread across below `flatness` of the
+    spread along); else the centre. Centres alone are up to half a cell off the surface each, and
+    a scan matched to them was 2 cm off the truth (median; a map made from the simulated lidar,
+    saved as map_saver saves it); to the fitted lines 0.9 cm (radius 3, 2026-11-23)."""
+    size = np.arange(-radius, radius + 1)
+    kernel = (np.hypot(*np.meshgrid(size, size)) <= radius).astype(float)
+    centres = grid.all_centres()
+    weight = occupied.astype(float)
+
+    def local(values):
+        return ndimage.convolve(weight * values, kernel, mode='constant')
+    count = np.maximum(local(np.ones(grid.shape)), 1.0)
+    x, y = centres[..., 0], centres[..., 1]
+    mean_x, mean_y = local(x) / count, local(y) / count
+    sxx, syy = local(x * x) / count - mean_x ** 2, local(y * y) / count - mean_y ** 2
+    sxy = local(x * y) / count - mean_x * mean_y
+    angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
+    half_sum, root = 0.5 * (sxx + syy), np.sqrt(0.25 * (sxx - syy) ** 2 + sxy ** 2)
+    along_x, along_y = np.cos(angle), np.sin(angle)
+    reach = (x - mean_x) * along_x + (y - mean_y) * along_y
+    on_line = np.stack((mean_x + reach * along_x, mean_y + reach * along_y), axis=-1)
+    line = occupied & (half_sum - root < flatness * (half_sum + root))
+    means = np.full(grid.shape + (2,), np.nan)
+    means[occupied] = centres[occupied]
+    means[line] = on_line[line]
+    return means

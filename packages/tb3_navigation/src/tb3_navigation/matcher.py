@@ -16,7 +16,8 @@ end point is paired, through the distance transform's nearest-cell index,
 with the occupied cell nearest to it, and measured against the line
 through that cell's mean end point (where in the cell its wall lies) along
 the wall's direction there (from the mean points of the occupied cells
-within 2 cells). Why not Gauss-Newton on the field itself, as Hector SLAM
+within 2 cells), unless that wall was seen from the other side only (see
+ONE_SIDED). Why not Gauss-Newton on the field itself, as Hector SLAM
 does: the field is known at cell centres only, so its optimum snaps to
 them; with turtlebot3_world's drive and a map made at the true poses, the
 field's optimum was 7 mm and 0.15 degree (rms) off the truth for scans
@@ -34,6 +35,13 @@ from scipy import ndimage
 
 from tb3_common.pose2d import normalize_angle
 
+#: A point pairs only with a wall seen from the point's side, when the wall's cell was seen from one side:
+#: the mean of the unit vectors from its hits back to the sensor reaches at least this far along the
+#: wall's normal (a post seen all round has no side). The two faces of the house's inner walls lie 0.12 m
+#: apart, within the pairing's reach, and a robot that came round such a wall was pulled onto the face
+#: it had seen from the other side (by 16 cm on an exploration). The scanner is taken to be at the base
+#: (3 cm off on a Burger).
+ONE_SIDED = 0.3
 #: Half the side, in cells, of the square of occupied cells whose mean points give a wall's direction.
 SHAPE_RADIUS = 2
 #: A cell's neighbourhood is taken as a line when its spread across is below this share of its spread along
@@ -49,10 +57,11 @@ CORNER_WEIGHT = 0.3
 
 
 class WallShapes(object):
-    """Each occupied cell's wall point (the mean of its hits, else its centre) and pairing matrix (see
-    _pairing) over a whole `grid`, kept up to date cell by cell: a scan added to a map changes a few
-    thousand cells of the grid's 160 000 and the matrices of a few hundred, and remaking all of them at
-    each map update was a third of the SLAM's CPU on the house (doc/speed.md)."""
+    """Each occupied cell's wall point (the mean of its hits, else its centre), pairing matrix (see
+    _pairing) and the side it was seen from (OccupancyGrid.hit_views; NaN: not known) over a whole
+    `grid`, kept up to date cell by cell: a scan added to a map changes a few thousand cells of the
+    grid's 160 000 and the matrices of a few hundred, and remaking all of them at each map update was a
+    third of the SLAM's CPU on the house (doc/speed.md)."""
 
     def __init__(self, grid):
         self.grid = grid
@@ -60,23 +69,26 @@ class WallShapes(object):
         # Framed by SHAPE_RADIUS cells of NaN: a cell's neighbourhood is then at hand even at the grid's edge.
         self.points = np.full((grid.height + 2 * r, grid.width + 2 * r, 2), np.nan)
         self.pairing = np.zeros((grid.height + 2 * r, grid.width + 2 * r, 2, 2))
+        self.views = np.full((grid.height + 2 * r, grid.width + 2 * r, 2), np.nan)
 
     @classmethod
-    def of_map(cls, grid, occupied, means=None):
+    def of_map(cls, grid, occupied, means=None, views=None):
         """The shapes of a whole map: `occupied` (bool, the grid's shape), `means` (height, width, 2; NaN
-        where a cell has none) or None (the cells' centres)."""
+        where a cell has none) or None (the cells' centres), `views` likewise (None: no side known)."""
         shapes = cls(grid)
         shapes.update(np.arange(grid.width * grid.height), np.ravel(occupied),
-                      None if means is None else np.reshape(means, (-1, 2)))
+                      None if means is None else np.reshape(means, (-1, 2)),
+                      None if views is None else np.reshape(views, (-1, 2)))
         return shapes
 
     def _framed(self, cells):
         r, width = SHAPE_RADIUS, self.grid.width
         return (cells // width + r) * (width + 2 * r) + cells % width + r
 
-    def update(self, cells, occupied, means=None):
+    def update(self, cells, occupied, means=None, views=None):
         """Take the state of the grid's `cells` (flat indices into its shape, each once): whether each
-        is `occupied`, and the mean (k, 2) of the hits in it (NaN: none; None: the centres)."""
+        is `occupied`, the mean (k, 2) of the hits in it (NaN: none; None: the centres) and the side
+        (k, 2) it was seen from (NaN or None: not known)."""
         cells = np.asarray(cells, dtype=np.intp)
         width = self.grid.width
         points = self.grid.centres(np.stack((cells % width, cells // width), axis=-1))
@@ -84,6 +96,7 @@ class WallShapes(object):
             points = np.where(np.isnan(means), points, means)
         points[~np.asarray(occupied, dtype=bool)] = np.nan
         framed = self._framed(cells)
+        self.views.reshape(-1, 2)[framed] = np.nan if views is None else views
         flat = self.points.reshape(-1, 2)
         old = flat[framed]
         changed = np.any((points != old) & ~(np.isnan(points) & np.isnan(old)), axis=-1)
@@ -140,9 +153,9 @@ class WallField(object):
         self._nearest = (nearest[0] + self.row0 + r) * (grid.width + 2 * r) + nearest[1] + self.col0 + r
 
     @classmethod
-    def of_map(cls, grid, occupied, sigma, means=None):
-        """The field of a whole map: `occupied` (bool, the grid's shape) and `means` as WallShapes.of_map's."""
-        return cls(WallShapes.of_map(grid, occupied, means), sigma)
+    def of_map(cls, grid, occupied, sigma, means=None, views=None):
+        """The field of a whole map: `occupied` (bool, the grid's shape), `means` and `views` as WallShapes.of_map's."""
+        return cls(WallShapes.of_map(grid, occupied, means, views), sigma)
 
     def covers(self, box):
         """Whether the field was made over the whole of `box` (row0, row1, col0, col1)."""
@@ -178,15 +191,18 @@ class WallField(object):
     def walls(self, points):
         """For points (n, 2): the wall point (n, 2) each is paired with, the pairing matrix (n, 2, 2)
         that turns the offset from it into the residual (the wall's normal in its first row, and
-        nothing more along a wall; a weighted identity at a corner), and whether it has one (n,)."""
+        nothing more along a wall; a weighted identity at a corner), the side (n, 2) the wall was
+        seen from (WallShapes.views), and whether it has one (n,)."""
         if self.empty:
-            return np.zeros_like(points), np.zeros((len(points), 2, 2)), np.zeros(len(points), dtype=bool)
+            return (np.zeros_like(points), np.zeros((len(points), 2, 2)), np.full_like(points, np.nan),
+                    np.zeros(len(points), dtype=bool))
         cells = self.grid.to_cells(points) - (self.col0, self.row0)
         height, width = self._nearest.shape
         inside = (cells[:, 0] >= 0) & (cells[:, 0] < width) & (cells[:, 1] >= 0) & (cells[:, 1] < height)
         index = self._nearest[np.clip(cells[:, 1], 0, height - 1), np.clip(cells[:, 0], 0, width - 1)]
-        return (self._shapes.points.reshape(-1, 2)[index], self._shapes.pairing.reshape(-1, 2, 2)[index],
-                inside)
+        shapes = self._shapes
+        return (shapes.points.reshape(-1, 2)[index], shapes.pairing.reshape(-1, 2, 2)[index],
+                shapes.views.reshape(-1, 2)[index], inside)
 
     def score(self, points):
         """Sum of the field under points (..., n, 2): about how many of them lie on the map's walls."""
@@ -278,9 +294,15 @@ def refine(field, points, pose, iterations, prior=None, prior_weight=0.0, reach=
         cos, sin = math.cos(pose[2]), math.sin(pose[2])
         tx, ty = cos * px - sin * py, sin * px + cos * py  # the points turned, not moved
         world = np.stack((tx + pose[0], ty + pose[1]), axis=-1)
-        wall, pairing, paired = field.walls(world)
+        wall, pairing, seen_from, paired = field.walls(world)
         offset = world - wall
-        use = paired & (np.einsum('ni,ni->n', offset, offset) < reach * reach)
+        # Not with a wall seen from its other side only: along its normal (a line's; a corner's is not
+        # known), the side it was seen from (NaN: not known) and the base's now have opposite signs.
+        normal = pairing[:, 0]
+        seen = normal[:, 0] * seen_from[:, 0] + normal[:, 1] * seen_from[:, 1]
+        far_side = (np.abs(seen) >= ONE_SIDED) & (seen * (normal[:, 0] * tx + normal[:, 1] * ty) > 0)
+        far_side &= ~pairing[:, 1].any(axis=-1)
+        use = paired & ~far_side & (np.einsum('ni,ni->n', offset, offset) < reach * reach)
         if use.sum() < 3:
             break
         (a, b), (c, d) = pairing[use, 0].T, pairing[use, 1].T
@@ -327,33 +349,3 @@ def _pairing(points, rows, cols):
     cell[:, 0, 0], cell[:, 0, 1] = -np.sin(along), np.cos(along)
     cell[~line] = CORNER_WEIGHT * np.eye(2)
     return cell
-
-def line_means(grid, occupied, radius=3, flatness=0.1):
-    """Wall points for a map that keeps no hits (one loaded from a file): each occupied cell's
-    centre put on the line fitted (principal axis) through the occupied cells' centres within
-    `radius` cells of it, where those lie along a line (spread across below `flatness` of the
-    spread along); else the centre. Centres alone are up to half a cell off the surface each, and
-    a scan matched to them was 2 cm off the truth (median; a map made from the simulated lidar,
-    saved as map_saver saves it); to the fitted lines 0.9 cm (radius 3, 2026-11-23)."""
-    size = np.arange(-radius, radius + 1)
-    kernel = (np.hypot(*np.meshgrid(size, size)) <= radius).astype(float)
-    centres = grid.all_centres()
-    weight = occupied.astype(float)
-
-    def local(values):
-        return ndimage.convolve(weight * values, kernel, mode='constant')
-    count = np.maximum(local(np.ones(grid.shape)), 1.0)
-    x, y = centres[..., 0], centres[..., 1]
-    mean_x, mean_y = local(x) / count, local(y) / count
-    sxx, syy = local(x * x) / count - mean_x ** 2, local(y * y) / count - mean_y ** 2
-    sxy = local(x * y) / count - mean_x * mean_y
-    angle = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
-    half_sum, root = 0.5 * (sxx + syy), np.sqrt(0.25 * (sxx - syy) ** 2 + sxy ** 2)
-    along_x, along_y = np.cos(angle), np.sin(angle)
-    reach = (x - mean_x) * along_x + (y - mean_y) * along_y
-    on_line = np.stack((mean_x + reach * along_x, mean_y + reach * along_y), axis=-1)
-    line = occupied & (half_sum - root < flatness * (half_sum + root))
-    means = np.full(grid.shape + (2,), np.nan)
-    means[occupied] = centres[occupied]
-    means[line] = on_line[line]
-    return means

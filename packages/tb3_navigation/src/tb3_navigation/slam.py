@@ -223,7 +223,7 @@ class Slam(object):
         self.map, self._redraw = grid, None
         self.map.take_touched()
         self._shapes = matcher.WallShapes.of_map(self.map.grid, self.map.occupied(self.config.occ_thresh),
-                                                 self.map.hit_means())
+                                                 self.map.hit_means(), self.map.hit_views())
         self._touched, self._field = np.zeros(0, dtype=np.intp), None
         self.map_updates += 1
         self._shapes_version = self.map_updates
@@ -266,7 +266,8 @@ class Slam(object):
             self._touched = np.union1d(self._touched, self.map.take_touched())
             occupied = self.map.occupied_at(self._touched, c.occ_thresh)
             if np.any(occupied != self._shapes.has_point(self._touched)):
-                self._shapes.update(self._touched, occupied, self.map.hit_means().reshape(-1, 2)[self._touched])
+                self._shapes.update(self._touched, occupied, self.map.hit_means().reshape(-1, 2)[self._touched],
+                                    self.map.hit_views().reshape(-1, 2)[self._touched])
                 self._touched, self._field = self._touched[:0], None
             self._shapes_version = self.map_updates
         needed = self._box(priors, c.maxUrange + widen * c.search_linear + c.delta)
