@@ -49,8 +49,7 @@ def field_of(obstacles, poses, rng):
     for pose in poses:
         sensor = tuple(compose(pose, SENSOR))
         grid_map.add_scan(sensor, ray_cast(obstacles, sensor, rng), MAX_URANGE, RANGE_MAX)
-    return matcher.WallField.of_map(grid_map.grid, grid_map.occupied(), SIGMA, grid_map.hit_means(),
-                                    grid_map.hit_views())
+    return matcher.WallField(matcher.WallShapes.of_map(grid_map.grid, *grid_map.walls()), SIGMA)
 
 
 def points_at(obstacles, pose, rng):
@@ -162,10 +161,11 @@ def test_shapes_kept_up_to_date_scan_by_scan_are_those_of_the_whole_map():
         grid_map.add_scan(sensor, ray_cast(ROOM, sensor, rng), MAX_URANGE, RANGE_MAX)
         cells = grid_map.take_touched()
         assert 0 < len(cells) < grid_map.hits.size // 4  # a scan changes only the cells it saw
-        shapes.update(cells, grid_map.occupied_at(cells), grid_map.hit_means().reshape(-1, 2)[cells])
-        whole = matcher.WallShapes.of_map(grid_map.grid, grid_map.occupied(), grid_map.hit_means())
+        shapes.update(cells, *grid_map.walls(cells=cells))
+        whole = matcher.WallShapes.of_map(grid_map.grid, *grid_map.walls())
         np.testing.assert_array_equal(shapes.points, whole.points)
         np.testing.assert_array_equal(shapes.pairing, whole.pairing)
+        np.testing.assert_array_equal(shapes.views, whole.views)
     assert shapes.has_point(np.flatnonzero(grid_map.occupied())).all()
     truth = (0.3, -0.2, 0.4)
     points = points_at(ROOM, truth, np.random.default_rng(4))

@@ -108,8 +108,7 @@ class LoopCloser(object):
         submap = OccupancyGrid.around(c.delta, pose[0] - reach, pose[1] - reach, pose[0] + reach, pose[1] + reach)
         for i in indices:
             self._draw(submap, i)
-        field = matcher.WallField.of_map(submap.grid, submap.occupied(c.occ_thresh), c.sigma, submap.hit_means(),
-                                         submap.hit_views())
+        field = matcher.WallField(matcher.WallShapes.of_map(submap.grid, *submap.walls(c.occ_thresh)), c.sigma)
         return None if field.empty else field
 
     def _old_scans_near(self, index, walls):

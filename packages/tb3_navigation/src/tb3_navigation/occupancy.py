@@ -112,10 +112,6 @@ class OccupancyGrid(object):
         self._touched[:] = False
         return touched
 
-    def occupied_at(self, cells, occ_thresh=OCC_THRESH):
-        """occupied() at `cells` (flat indices)."""
-        return self.hits.flat[cells] > occ_thresh * self.visits.flat[cells]
-
     def hit_means(self):
         """The mean (height, width, 2) of the end points that fell in each cell, NaN in a cell none
         fell in: kept up to date scan by scan, so this is the grid's own array (read it only)."""
@@ -126,6 +122,14 @@ class OccupancyGrid(object):
         to the sensor, NaN in a cell none fell in: the side its wall was seen from (length near 1: one side
         only; near 0: both, as a post seen all round). The grid's own array, as hit_means'."""
         return self._views
+
+    def walls(self, occ_thresh=OCC_THRESH, cells=None):
+        """What the scan matcher takes of the map (matcher.WallShapes), flat: whether each cell is
+        occupied (k,), the mean of its hits (k, 2) and the side it was seen from (k, 2), over the
+        whole grid or at `cells` (flat indices)."""
+        cells = slice(None) if cells is None else cells
+        return (np.ravel(self.hits)[cells] > occ_thresh * np.ravel(self.visits)[cells],
+                self._means.reshape(-1, 2)[cells], self._views.reshape(-1, 2)[cells])
 
     def known(self):
         return self.visits > 0

@@ -222,8 +222,7 @@ class Slam(object):
             return
         self.map, self._redraw = grid, None
         self.map.take_touched()
-        self._shapes = matcher.WallShapes.of_map(self.map.grid, self.map.occupied(self.config.occ_thresh),
-                                                 self.map.hit_means(), self.map.hit_views())
+        self._shapes = matcher.WallShapes.of_map(self.map.grid, *self.map.walls(self.config.occ_thresh))
         self._touched, self._field = np.zeros(0, dtype=np.intp), None
         self.map_updates += 1
         self._shapes_version = self.map_updates
@@ -264,10 +263,9 @@ class Slam(object):
             # changes, not at every added scan: wall points that follow each scan pulled the poses along
             # with them (the house round: median error 1.6 -> 3.2 cm).
             self._touched = np.union1d(self._touched, self.map.take_touched())
-            occupied = self.map.occupied_at(self._touched, c.occ_thresh)
+            occupied, means, views = self.map.walls(c.occ_thresh, self._touched)
             if np.any(occupied != self._shapes.has_point(self._touched)):
-                self._shapes.update(self._touched, occupied, self.map.hit_means().reshape(-1, 2)[self._touched],
-                                    self.map.hit_views().reshape(-1, 2)[self._touched])
+                self._shapes.update(self._touched, occupied, means, views)
                 self._touched, self._field = self._touched[:0], None
             self._shapes_version = self.map_updates
         needed = self._box(priors, c.maxUrange + widen * c.search_linear + c.delta)

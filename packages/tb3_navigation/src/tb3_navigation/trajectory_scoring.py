@@ -90,9 +90,9 @@ class TrajectoryScorer(object):
         scale_goal = config.goal_distance_bias * grid.resolution
         cells = _plan_cells(costmap, dense)
         ahead = config.forward_point_scoring  # false: TrajectoryPlannerROS's critics, the end point alone
-        counts = step_counter(blocked)
-        return dict(path=_steps_from(counts, blocked, cells), goal=_steps_from(counts, blocked, cells[-1:]),
-                    front=_steps_from(counts, blocked, _plan_cells(costmap, front)[-1:]) if ahead else None,
+        steps_from = _map_grid_steps(blocked)
+        return dict(path=steps_from(cells), goal=steps_from(cells[-1:]),
+                    front=steps_from(_plan_cells(costmap, front)[-1:]) if ahead else None,
                     scale_path=scale_path, scale_goal=scale_goal, scale_front=scale_goal if ahead else 0.0,
                     scale_alignment=0.0 if near_goal or not ahead else scale_path)
 
@@ -208,15 +208,19 @@ def _plan_cells(costmap, points):
     return cells[:, 1] * grid.width + cells[:, 0]
 
 
-def _steps_from(counts, blocked, sources):
-    """4-neighbour step counts (H, W) from the nearest source around blocked cells (`counts`, a
-    step_counter of them); blocked cells count H * W (MapGrid's obstacleCosts), unreached ones H * W + 1."""
-    size = blocked.size
-    if not len(sources):
-        return np.full(blocked.shape, size + 1.0)
-    distances = counts(sources)
-    distances[blocked] = np.where(np.isfinite(distances[blocked]), distances[blocked], size)
-    return np.where(np.isfinite(distances), distances, size + 1.0)
+def _map_grid_steps(blocked):
+    """MapGrid's 4-neighbour step counts (H, W) around `blocked` cells from the nearest of some sources
+    (flat indices), as a function of the sources: blocked cells count H * W (its obstacleCosts),
+    unreached ones H * W + 1."""
+    size, counts = blocked.size, step_counter(blocked)
+
+    def steps_from(sources):
+        if not len(sources):
+            return np.full(blocked.shape, size + 1.0)
+        distances = counts(sources)
+        distances[blocked] = np.where(np.isfinite(distances[blocked]), distances[blocked], size)
+        return np.where(np.isfinite(distances), distances, size + 1.0)
+    return steps_from
 
 
 def _lookup(grid, values, points):
