@@ -277,11 +277,7 @@ def refine(field, points, pose, iterations, prior=None, prior_weight=0.0, reach=
     heading with a lever of 1 m): it holds the pose where no wall does, as along a corridor,
     and barely moves it where a few hundred points agree. `prior_weight` may also be a (3, 3)
     information matrix on (x, y, yaw) in the same units (points' worth), to pull more in some
-    directions than in others. Returns the pose and its score.
-
-    Each step solves the 3 x 3 normal equations, summed from the residuals' two rows by hand:
-    a least-squares solver on the stacked (2n + 3, 3) rows took 4 times as long."""
-    reach = 3.0 * field.sigma if reach is None else reach
+    directions than in others. Returns the pose and its score."""
     pose = np.array(pose, dtype=float)
     information = None
     if prior is not None:
@@ -289,32 +285,11 @@ def refine(field, points, pose, iterations, prior=None, prior_weight=0.0, reach=
         information = max(float(weight), 0.0) * np.eye(3) if weight.ndim == 0 else weight
         if not information.any():
             information = None
-    px, py = points[:, 0], points[:, 1]
     for _ in range(iterations):
-        cos, sin = math.cos(pose[2]), math.sin(pose[2])
-        tx, ty = cos * px - sin * py, sin * px + cos * py  # the points turned, not moved
-        world = np.stack((tx + pose[0], ty + pose[1]), axis=-1)
-        wall, pairing, seen_from, paired = field.walls(world)
-        offset = world - wall
-        # Not with a wall seen from its other side only: along its normal (a line's; a corner's is not
-        # known), the side it was seen from (NaN: not known) and the base's now have opposite signs.
-        normal = pairing[:, 0]
-        seen = normal[:, 0] * seen_from[:, 0] + normal[:, 1] * seen_from[:, 1]
-        far_side = (np.abs(seen) >= ONE_SIDED) & (seen * (normal[:, 0] * tx + normal[:, 1] * ty) > 0)
-        far_side &= ~pairing[:, 1].any(axis=-1)
-        use = paired & ~far_side & (np.einsum('ni,ni->n', offset, offset) < reach * reach)
-        if use.sum() < 3:
+        equations = normal_equations(field, points, pose, reach)
+        if equations is None:
             break
-        (a, b), (c, d) = pairing[use, 0].T, pairing[use, 1].T
-        ox, oy, tx, ty = offset[use, 0], offset[use, 1], tx[use], ty[use]
-        # The residual's two rows (pairing . offset) and their derivatives by (x, y, yaw): d(point) =
-        # [[1, 0, -ty], [0, 1, tx]].
-        rows = np.stack((a, b, b * tx - a * ty, a * ox + b * oy, c, d, d * tx - c * ty, c * ox + d * oy))
-        # Cauchy weights on the squared residual: w = 1 / (1 + r^2 / sigma^2).
-        w = 1.0 / (1.0 + (rows[3] ** 2 + rows[7] ** 2) / field.sigma ** 2)
-        first, second = rows[:4] * np.sqrt(w), rows[4:] * np.sqrt(w)
-        normal = first.dot(first.T) + second.dot(second.T)  # (4, 4): [J^T W J, J^T W r; ., .]
-        hessian, gradient = normal[:3, :3], -normal[:3, 3]
+        hessian, gradient = equations
         if information is not None:
             towards = np.array((prior[0] - pose[0], prior[1] - pose[1], normalize_angle(prior[2] - pose[2])))
             hessian, gradient = hessian + information, gradient + information.dot(towards)
@@ -326,6 +301,43 @@ def refine(field, points, pose, iterations, prior=None, prior_weight=0.0, reach=
             break
     pose[2] = normalize_angle(pose[2])
     return tuple(pose), float(field.score(place(pose, points)))
+
+
+def normal_equations(field, points, pose, reach=None):
+    """The Gauss-Newton normal equations (hessian (3, 3), gradient (3,): a step solves hessian . step =
+    gradient) of the points (base frame) at `pose` against the walls they pair with, as refine weighs
+    them (its `reach`); None if fewer than 3 points pair. The hessian is what the scan tells of the
+    pose, in points' worth (a point on a line, one along its normal; the heading with a lever of 1 m).
+
+    Summed from the residuals' two rows by hand: a least-squares solver on the stacked (2n + 3, 3)
+    rows took 4 times as long."""
+    reach = 3.0 * field.sigma if reach is None else reach
+    px, py = points[:, 0], points[:, 1]
+    cos, sin = math.cos(pose[2]), math.sin(pose[2])
+    tx, ty = cos * px - sin * py, sin * px + cos * py  # the points turned, not moved
+    world = np.stack((tx + pose[0], ty + pose[1]), axis=-1)
+    wall, pairing, seen_from, paired = field.walls(world)
+    offset = world - wall
+    # Not with a wall seen from its other side only: along its normal (a line's; a corner's is not
+    # known), the side it was seen from (NaN: not known) and the base's now have opposite signs.
+    normal = pairing[:, 0]
+    seen = normal[:, 0] * seen_from[:, 0] + normal[:, 1] * seen_from[:, 1]
+    far_side = (np.abs(seen) >= ONE_SIDED) & (seen * (normal[:, 0] * tx + normal[:, 1] * ty) > 0)
+    far_side &= ~pairing[:, 1].any(axis=-1)
+    use = paired & ~far_side & (np.einsum('ni,ni->n', offset, offset) < reach * reach)
+    if use.sum() < 3:
+        return None
+    (a, b), (c, d) = pairing[use, 0].T, pairing[use, 1].T
+    ox, oy, tx, ty = offset[use, 0], offset[use, 1], tx[use], ty[use]
+    # The residual's two rows (pairing . offset) and their derivatives by (x, y, yaw): d(point) =
+    # [[1, 0, -ty], [0, 1, tx]].
+    rows = np.stack((a, b, b * tx - a * ty, a * ox + b * oy, c, d, d * tx - c * ty, c * ox + d * oy))
+    # Cauchy weights on the squared residual: w = 1 / (1 + r^2 / sigma^2).
+    w = 1.0 / (1.0 + (rows[3] ** 2 + rows[7] ** 2) / field.sigma ** 2)
+    first, second = rows[:4] * np.sqrt(w), rows[4:] * np.sqrt(w)
+    normal = first.dot(first.T) + second.dot(second.T)  # (4, 4): [J^T W J, J^T W r; ., .]
+    return normal[:3, :3], -normal[:3, 3]
+
 
 def _pairing(points, rows, cols):
     """The pairing matrices (cells, 2, 2) of the cells (`rows`, `cols`) of `points` (a WallShapes'

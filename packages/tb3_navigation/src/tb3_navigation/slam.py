@@ -58,6 +58,12 @@ JUMP_SEARCH = 3
 #: m the likelihood field reaches beyond where a scan can land: the robot may drive that far before it
 #: is made anew (at 0.22 m/s, 2 s of driving when the map does not change).
 FIELD_SLACK = 0.5
+#: Points' worth of information a match has in every direction at least (x, y, and the heading with a
+#: lever of 1 m): where the scan tells less (along a hallway, past a doorway: a few door frames and
+#: corners against hundreds of points on two walls), the odometry's prediction makes up the rest.
+#: With odom_weight's 20 alone, those few points slid the pose along hallways the map had drawn a
+#: little off, and the map followed: 20 cm off in 50 s on perfect odometry (doc/speed.md).
+SURE = 150.0
 #: After a loop closure the map is drawn anew from every scan of the graph, this many at each scan that
 #: comes in: all at once, a redraw on the drive round the outside of the house took 2 s of CPU in one
 #: scan's update, and a simulator in lockstep waits 0.5 s at most (doc/speed.md). Meanwhile the pose
@@ -242,7 +248,7 @@ class Slam(object):
             start, _ = matcher.search(field, points, prior, widen * c.search_linear, widen * c.search_angular,
                                       c.lstep, c.astep)
             pose, score = matcher.refine(field, points, start, widen * c.iterations, prior,
-                                         c.odom_weight if widen == 1 else 0.0)
+                                         self._prior_information(field, points, start) if widen == 1 else 0.0)
             if score > best_score:
                 best, best_score = pose, score
         self.score = best_score
@@ -250,6 +256,13 @@ class Slam(object):
             return None
         self.matched = True
         return best
+
+    def _prior_information(self, field, points, pose):
+        """The odometry prior's information for a match from `pose`: odom_weight in every direction, and
+        in a direction the scan tells less of than SURE points' worth (along a corridor), the rest."""
+        equations = matcher.normal_equations(field, points, pose)
+        told, directions = np.linalg.eigh(equations[0] if equations is not None else np.zeros((3, 3)))
+        return (directions * np.maximum(self.config.odom_weight, SURE - told)).dot(directions.T)
 
     def _likelihood(self, priors, widen):
         """The likelihood field of the map around `priors`, made anew only when the set of occupied cells
