@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from tb3_common.pose2d import compose
-from tb3_navigation import matcher
+from tb3_navigation import matcher, wall_shapes
 from tb3_navigation.occupancy import OccupancyGrid
 from tb3_navigation.scan import Scan
 from tb3_sim_nav import world_map
@@ -49,7 +49,7 @@ def field_of(obstacles, poses, rng):
     for pose in poses:
         sensor = tuple(compose(pose, SENSOR))
         grid_map.add_scan(sensor, ray_cast(obstacles, sensor, rng), MAX_URANGE, RANGE_MAX)
-    return matcher.WallField(matcher.WallShapes.of_map(grid_map.grid, *grid_map.walls()), SIGMA)
+    return matcher.WallField(wall_shapes.WallShapes.of_map(grid_map.grid, *grid_map.walls()), SIGMA)
 
 
 def points_at(obstacles, pose, rng):
@@ -155,14 +155,14 @@ def test_shapes_kept_up_to_date_scan_by_scan_are_those_of_the_whole_map():
     rng = np.random.default_rng(9)
     grid_map = OccupancyGrid.around(0.05, -3.0, -3.0, 7.0, 3.0)
     grid_map.take_touched()
-    shapes = matcher.WallShapes(grid_map.grid)
+    shapes = wall_shapes.WallShapes(grid_map.grid)
     for pose in [(-1.0, 0.5, 0.0), (1.0, -0.6, 2.0), (0.0, 0.0, -1.0), (0.5, 0.8, 2.5)]:
         sensor = tuple(compose(pose, SENSOR))
         grid_map.add_scan(sensor, ray_cast(ROOM, sensor, rng), MAX_URANGE, RANGE_MAX)
         cells = grid_map.take_touched()
         assert 0 < len(cells) < grid_map.hits.size // 4  # a scan changes only the cells it saw
         shapes.update(cells, *grid_map.walls(cells=cells))
-        whole = matcher.WallShapes.of_map(grid_map.grid, *grid_map.walls())
+        whole = wall_shapes.WallShapes.of_map(grid_map.grid, *grid_map.walls())
         np.testing.assert_array_equal(shapes.points, whole.points)
         np.testing.assert_array_equal(shapes.pairing, whole.pairing)
         np.testing.assert_array_equal(shapes.views, whole.views)

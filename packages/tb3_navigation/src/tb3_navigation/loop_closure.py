@@ -23,6 +23,7 @@ from tb3_common.pose2d import compose, normalize_angle, relative
 from . import matcher
 from .occupancy import OccupancyGrid
 from .pose_graph import PoseGraph
+from .wall_shapes import WallShapes
 
 #: Information (inverse covariance) of a constraint between two scans in a row, and of a loop closure:
 #: 2 cm and 0.6 degree. The same for both, so that a closure's correction is spread evenly along the
@@ -108,7 +109,7 @@ class LoopCloser(object):
         submap = OccupancyGrid.around(c.delta, pose[0] - reach, pose[1] - reach, pose[0] + reach, pose[1] + reach)
         for i in indices:
             self._draw(submap, i)
-        field = matcher.WallField(matcher.WallShapes.of_map(submap.grid, *submap.walls(c.occ_thresh)), c.sigma)
+        field = matcher.WallField(WallShapes.of_map(submap.grid, *submap.walls(c.occ_thresh)), c.sigma)
         return None if field.empty else field
 
     def _old_scans_near(self, index, walls):

@@ -124,7 +124,7 @@ class OccupancyGrid(object):
         return self._views
 
     def walls(self, occ_thresh=OCC_THRESH, cells=None):
-        """What the scan matcher takes of the map (matcher.WallShapes), flat: whether each cell is
+        """What the scan matcher takes of the map (wall_shapes.WallShapes), flat: whether each cell is
         occupied (k,), the mean of its hits (k, 2) and the side it was seen from (k, 2), over the
         whole grid or at `cells` (flat indices)."""
         cells = slice(None) if cells is None else cells

@@ -51,6 +51,7 @@ from tb3_common.pose2d import IDENTITY, compose, inverse, relative
 from . import matcher
 from .loop_closure import LoopCloser, Node
 from .occupancy import OccupancyGrid
+from .wall_shapes import WallShapes
 
 #: After an odometry jump the prediction is only as good as the odometry's drift since the map last
 #: corrected it (turtlebot3_world's loop: 14 cm and 2.7 degrees after 55 s): search 3 times as far.
@@ -163,7 +164,7 @@ class Slam(object):
         self._last_added = None
         self._moved = self._turned = 0.0
         self.map.take_touched()  # a new map: nothing to carry over into the new shapes
-        self._shapes, self._shapes_version = matcher.WallShapes(self.map.grid), 0
+        self._shapes, self._shapes_version = WallShapes(self.map.grid), 0
         self._touched = np.zeros(0, dtype=np.intp)  # the map's cells changed since the shapes took them
         self._field = None
         self.loops = LoopCloser(self.config, self.map.grid)
@@ -228,7 +229,7 @@ class Slam(object):
             return
         self.map, self._redraw = grid, None
         self.map.take_touched()
-        self._shapes = matcher.WallShapes.of_map(self.map.grid, *self.map.walls(self.config.occ_thresh))
+        self._shapes = WallShapes.of_map(self.map.grid, *self.map.walls(self.config.occ_thresh))
         self._touched, self._field = np.zeros(0, dtype=np.intp), None
         self.map_updates += 1
         self._shapes_version = self.map_updates
@@ -247,8 +248,10 @@ class Slam(object):
         for prior in priors:
             start, _ = matcher.search(field, points, prior, widen * c.search_linear, widen * c.search_angular,
                                       c.lstep, c.astep)
+            equations = matcher.normal_equations(field, points, start) if widen == 1 else None
             pose, score = matcher.refine(field, points, start, widen * c.iterations, prior,
-                                         self._prior_information(field, points, start) if widen == 1 else 0.0)
+                                         self._prior_information(equations) if widen == 1 else 0.0,
+                                         first=equations)
             if score > best_score:
                 best, best_score = pose, score
         self.score = best_score
@@ -257,10 +260,10 @@ class Slam(object):
         self.matched = True
         return best
 
-    def _prior_information(self, field, points, pose):
-        """The odometry prior's information for a match from `pose`: odom_weight in every direction, and
-        in a direction the scan tells less of than SURE points' worth (along a corridor), the rest."""
-        equations = matcher.normal_equations(field, points, pose)
+    def _prior_information(self, equations):
+        """The odometry prior's information for a match whose scan tells `equations` (matcher.normal_equations
+        at the search's pose; None: nothing): odom_weight in every direction, and in a direction the scan
+        tells less of than SURE points' worth (along a corridor), the rest."""
         told, directions = np.linalg.eigh(equations[0] if equations is not None else np.zeros((3, 3)))
         return (directions * np.maximum(self.config.odom_weight, SURE - told)).dot(directions.T)
 
