@@ -65,7 +65,7 @@ def map_world(rounds, repeats=15):
     """Table rows (label, value) of test_map's load time and its lidar cost against turtlebot3_world's."""
     import numpy as np
 
-    import tb3_sim_nav.world
+    import tb3_sim_nav.world_rays
     from tb3_sim_nav.world import World
     from tb3_sim_nav.world_file import load_world
     test_map, worlds = os.path.join(ROOT, 'maps', 'rbx1', 'test_map.yaml'), os.path.join(ROOT, 'worlds')
@@ -84,10 +84,10 @@ def map_world(rounds, repeats=15):
         total = 0.0
         for x, y in spots:
             origin = np.array([x, y, 0.182])
-            world.cast([origin], [directions], 3.5, [None])
+            world.rays.cast([origin], [directions], 3.5, [None])
             start = time.process_time()
             for _ in range(repeats):
-                world.cast([origin], [directions], 3.5, [None])
+                world.rays.cast([origin], [directions], 3.5, [None])
             total += time.process_time() - start
         return total / repeats / len(spots)
 
@@ -95,15 +95,15 @@ def map_world(rounds, repeats=15):
     map_spots, world_spots = [(0.0, 0.0), (0.72, 2.23), (-0.86, 0.0)], [(-2.0, -0.5), (0.5, 0.5), (1.6, 1.6)]
     mapped = World(0.01, loaded.obstacles)
     reference = World(0.01, load_world('turtlebot3_world', worlds).obstacles)
-    every_beam, costs = tb3_sim_nav.world.MAX_STILL_SHAPES, []
+    every_beam, costs = tb3_sim_nav.world_rays.MAX_STILL_SHAPES, []
     try:
         for _ in range(rounds):  # interleaved
-            tb3_sim_nav.world.MAX_STILL_SHAPES = every_beam
+            tb3_sim_nav.world_rays.MAX_STILL_SHAPES = every_beam
             mapped_cost = scan_cost(mapped, map_spots)
-            tb3_sim_nav.world.MAX_STILL_SHAPES = -1
+            tb3_sim_nav.world_rays.MAX_STILL_SHAPES = -1
             costs.append((mapped_cost, scan_cost(reference, world_spots)))
     finally:
-        tb3_sim_nav.world.MAX_STILL_SHAPES = every_beam
+        tb3_sim_nav.world_rays.MAX_STILL_SHAPES = every_beam
         mapped.close()
         reference.close()
     occupied = int((loaded.map.values == 100).sum())

@@ -154,7 +154,7 @@ class Lidar(Sensor):
         directions = np.array([lidar._beams.dot(matrix(orientation).T) for lidar, (_, orientation) in
                                zip(lidars, poses)])
         reach = max(lidar.range_max for lidar in lidars)
-        distances = lidars[0].body.world.cast([position for position, _ in poses], directions, reach,
+        distances = lidars[0].body.world.rays.cast([position for position, _ in poses], directions, reach,
                                               [lidar.body for lidar in lidars])
         return [lidar._ranges(found) for lidar, found in zip(lidars, distances)]
 

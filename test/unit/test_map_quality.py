@@ -57,7 +57,7 @@ def lidar_map(obstacles, poses, believed=None, seed=1):
         for (x, y, yaw), (bx, by, byaw) in zip(poses, believed or poses):
             origin = np.array([x, y, BURGER_SCAN_HEIGHT])
             ends = origin + np.stack((3.5 * np.cos(yaw + angles), 3.5 * np.sin(yaw + angles), np.zeros(360)), -1)
-            ranges = simulated.cast([origin], [(ends - origin) / 3.5], 3.5, [None])[0] + rng.normal(0.0, 0.01, 360)
+            ranges = simulated.rays.cast([origin], [(ends - origin) / 3.5], 3.5, [None])[0] + rng.normal(0.0, 0.01, 360)
             scan = Scan(0.0, angles[1], ranges, 0.12, 3.5)
             stops, hit = scan.rays((bx, by, byaw), 3.5)
             crossed = crossed_cells(grid, (bx, by), stops)

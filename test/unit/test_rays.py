@@ -2,7 +2,7 @@
 at its links' frames, rays that pass through their owner's shapes; its culling against every ray tested against
 every shape. No pybullet.
 
-The lidar's ranges come from here for every box, cylinder and sphere (world.World.cast),
+The lidar's ranges come from here for every box, cylinder and sphere (world_rays.WorldRays.cast),
 so they must be the exact surfaces: pybullet's convex cast stopped up to 6 mm
 short of a cylinder, a bias this must not copy. test_world_rays.py checks the
 same casts against pybullet's, where the two agree.

@@ -1,4 +1,4 @@
-"""World.cast on a real pybullet world (DIRECT) against pybullet's own rayTestBatch: the obstacles, other
+"""WorldRays.cast on a real pybullet world (DIRECT) against pybullet's own rayTestBatch: the obstacles, other
 robots (standing, tilted, thrown, teleported), spawned models and a robot with a mesh, and hand-worked
 distances to a Burger's shapes."""
 import math
@@ -13,7 +13,7 @@ GRAZE_AGREE = 0.007  # m: pybullet's ray cast against the exact surfaces, where 
 
 
 def every_ray_cast(robot, origin, directions, length):
-    """What World.cast must give: pybullet's own answer for every ray, `robot` transparent to them."""
+    """What WorldRays.cast must give: pybullet's own answer for every ray, `robot` transparent to them."""
     ends = origin + directions * length
     hits = robot.p.rayTestBatch(np.broadcast_to(origin, ends.shape), ends, numThreads=1,
                                 collisionFilterMask=int32(0xFFFFFFFF & ~robot.group))
@@ -55,7 +55,7 @@ def test_the_worlds_rays_meet_what_pybullets_meet(world_factory, worlds_folder, 
         directions /= np.linalg.norm(directions, axis=1)[:, None]
         length = rng.uniform(0.1, 4.0)
         expected = every_ray_cast(robot, origin, directions, length)
-        got = world.cast([origin], directions[None], length, [robot])[0]
+        got = world.rays.cast([origin], directions[None], length, [robot])[0]
         hits += np.isfinite(expected).sum()
         rays += len(expected)
         agree += agreeing(got, expected).sum()
@@ -75,7 +75,7 @@ def test_rays_in_a_world_of_shapes_and_robots_are_not_cast_by_pybullet(world_fac
     robot.world.add_robot(load_model(str(burger_urdf)).urdf_text, planar(SCAN_X, 1.0), 'other')
     monkeypatch.setattr(pybullet, 'rayTestBatch', lambda *args, **kwargs: pytest.fail('cast'))
     directions = np.array([[[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.6, -0.8]], [[0.0, 1.0, 0.0]] * 3])
-    distances = robot.world.cast([(SCAN_X, 0.0, 0.2), (SCAN_X, 0.0, 0.1)], directions, 3.5, [robot] * 2)
+    distances = robot.world.rays.cast([(SCAN_X, 0.0, 0.2), (SCAN_X, 0.0, 0.1)], directions, 3.5, [robot] * 2)
     assert distances[0] == pytest.approx([FRONT, RIGHT, 0.25])
     assert distances[1] == pytest.approx([1.0 - 0.070] * 3)  # the other robot's side: its box, 70 mm off its axis
 
@@ -94,7 +94,7 @@ def test_another_robot_is_met_at_its_urdf_shapes_where_its_links_are(world_facto
     world.add_robot(urdf, ((0.0, 2.0, 0.5), from_rpy(math.pi / 2, 0.0, 0.0)), 'lying')  # on its side, in the air
     origins = [(0.0, 0.0, 0.1), (0.0, 0.03, 0.175), (0.0, 0.08, 0.033), (-0.032, 0.0, 0.5), (-0.09, 0.0, 0.5)]
     directions = [[(1.0, 0.0, 0.0)]] * 3 + [[(0.0, 1.0, 0.0)]] * 2
-    got = world.cast(origins, directions, 3.5, [robot] * 5)[:, 0]
+    got = world.rays.cast(origins, directions, 3.5, [robot] * 5)[:, 0]
     assert got == pytest.approx([1.0 - 0.032 - 0.070,                                     # the box's back
                                  1.0 - 0.032 + 0.015 - math.sqrt(0.055 ** 2 - 0.03 ** 2),  # the lidar housing
                                  1.0 - 0.033,                                             # beside the box: a wheel
@@ -131,19 +131,19 @@ def aside(direction, distance, count=8):
 
 def cast_at(robot, targets, rng, count=20):
     """(hits, rays within GRAZE_AGREE of pybullet's, rays) of rays_at_robots cast by
-    World.cast and by pybullet, `robot`'s own body passed through; where the two
-    differ, pybullet's answer must be World.cast's for the ray moved 2 mm aside."""
+    WorldRays.cast and by pybullet, `robot`'s own body passed through; where the two
+    differ, pybullet's answer must be WorldRays.cast's for the ray moved 2 mm aside."""
     hits, agree, rays = 0, 0, 0
     for origin, directions in rays_at_robots(rng, targets, count):
         expected = every_ray_cast(robot, origin, directions, 3.5)
-        got = robot.world.cast([origin], directions[None], 3.5, [robot])[0]
+        got = robot.world.rays.cast([origin], directions[None], 3.5, [robot])[0]
         hits += np.isfinite(expected).sum()
         rays += len(expected)
         same = agreeing(got, expected)
         agree += same.sum()
         for index in np.flatnonzero(~same):
             moved = origin + aside(directions[index], 0.002)
-            found = robot.world.cast(moved, np.broadcast_to(directions[index], (len(moved), 1, 3)), 3.5,
+            found = robot.world.rays.cast(moved, np.broadcast_to(directions[index], (len(moved), 1, 3)), 3.5,
                                      [robot] * len(moved))[:, 0]
             assert agreeing(found, expected[index]).any()
     return hits, agree, rays
@@ -199,12 +199,12 @@ def test_a_robot_with_a_mesh_is_met_by_pybullet(world_factory, burger_urdf, tmp_
                                                 % mesh), planar(1.0, 0.0), 'meshed')
     assert meshed.collisions is None
     # 54 mm beside the housing's axis: the box's face 55 mm ahead of it, where a cylinder would be 10 mm.
-    got = robot.world.cast([(0.0, 0.054, 0.1755), (0.0, 0.0, 0.1)], [[(1.0, 0.0, 0.0)]] * 2, 3.5, [robot] * 2)
+    got = robot.world.rays.cast([(0.0, 0.054, 0.1755), (0.0, 0.0, 0.1)], [[(1.0, 0.0, 0.0)]] * 2, 3.5, [robot] * 2)
     assert got[:, 0] == pytest.approx([1.0 - 0.032 + 0.015 - 0.055, 1.0 - 0.032 - 0.070], abs=0.002)
     rng = np.random.default_rng(5)
     for origin, directions in rays_at_robots(rng, [meshed], count=5):
         expected = every_ray_cast(robot, origin, directions, 3.5)
-        assert agreeing(robot.world.cast([origin], directions[None], 3.5, [robot])[0], expected).all()
+        assert agreeing(robot.world.rays.cast([origin], directions[None], 3.5, [robot])[0], expected).all()
 
 
 #: A spawned URDF model: its root's inertial frame off and turned (pybullet's base is there), a box and a
