@@ -20,8 +20,9 @@ from tb3_common.grid import Grid
 from tb3_common.pose2d import compose
 from tb3_harness.measure import machine
 from tb3_harness.nav_sim import SCAN_POSE, Lidar, costmaps, world_cut  # the tests' world, lidar and map
-from tb3_navigation.controller import DwaController, dwa_config
+from tb3_navigation.controller import DwaController
 from tb3_navigation.costmap import Costmap, CostmapConfig
+from tb3_navigation.dwa_config import dwa_config
 from tb3_navigation.planner import GlobalPlanner, plan_length
 from tb3_sim_nav import world_map
 

@@ -20,7 +20,7 @@ NAVIGATION = [('slam_gmapping', '', 'tb3_navigation.slam.SlamConfig'),
               ('move_base', 'global_costmap/SOURCE/, local_costmap/SOURCE/',
                'move_base.costmap_params.ObservationSource'),
               ('move_base', 'NavfnROS/, GlobalPlanner/', 'tb3_navigation.planner.PlannerConfig'),
-              ('move_base', 'DWAPlannerROS/', 'tb3_navigation.controller.DwaConfig'),
+              ('move_base', 'DWAPlannerROS/', 'tb3_navigation.dwa_config.DwaConfig'),
               ('move_base', 'TrajectoryPlannerROS/', 'move_base.planners.TrajectoryPlannerConfig')]
 
 

@@ -89,7 +89,7 @@ def update_costmaps(global_costmap, local_costmap, pose, scan):
 def footprint_clearance(obstacles, footprint, pose):
     """Distance (m) from the footprint polygon at `pose` to the nearest obstacle
     (negative if they overlap): the least signed distance along its outline."""
-    from tb3_navigation.costmap import outline
+    from tb3_navigation.footprint import outline
     points = outline(footprint, 0.005)
     cos, sin = math.cos(pose[2]), math.sin(pose[2])
     world = np.stack((pose[0] + cos * points[:, 0] - sin * points[:, 1],

@@ -187,7 +187,7 @@ def closest(path, obstacles, footprint):
     """(clearance, the path's sample where the footprint came closest)."""
     import numpy as np
 
-    from tb3_navigation.costmap import outline as footprint_outline
+    from tb3_navigation.footprint import outline as footprint_outline
     from tb3_sim_nav.world_map import in_plane, signed_distance
     outline = footprint_outline(footprint, 0.01)
     cut = in_plane(obstacles)

@@ -23,8 +23,10 @@ from move_base.settings import Parameters, construct, resolve, trajectory_dwa
 from tb3_common.params import ParameterError
 from tb3_common.pose2d import compose
 from tb3_harness import nav_sim
-from tb3_navigation.controller import DwaConfig, DwaController, dwa_config
-from tb3_navigation.costmap import BURGER_FOOTPRINT, Costmap, CostmapConfig, circle_footprint, footprint_radii
+from tb3_navigation.controller import DwaController
+from tb3_navigation.costmap import BURGER_FOOTPRINT, Costmap, CostmapConfig
+from tb3_navigation.dwa_config import DwaConfig, dwa_config
+from tb3_navigation.footprint import circle_footprint, footprint_radii
 from tb3_navigation.navigator import SUCCEEDED, Navigator, NavigatorConfig
 from tb3_navigation.planner import GlobalPlanner, PlannerConfig
 

@@ -9,8 +9,9 @@ import pytest
 
 from tb3_common.pose2d import compose, normalize_angle
 from tb3_harness.nav_sim import Lidar, Unicycle, costmaps, footprint_clearance, odom_of, update_costmaps, world_cut
-from tb3_navigation.controller import STALLED, Command, DwaConfig, DwaController, dwa_config
+from tb3_navigation.controller import STALLED, Command, DwaController
 from tb3_navigation.costmap import BURGER_FOOTPRINT, Costmap, CostmapConfig
+from tb3_navigation.dwa_config import DwaConfig, dwa_config
 from tb3_navigation.planner import GlobalPlanner
 from tb3_navigation.trajectory_scoring import _densify, velocity_samples
 

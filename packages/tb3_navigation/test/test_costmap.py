@@ -18,10 +18,9 @@ from tb3_navigation.costmap import (
     WAFFLE_FOOTPRINT,
     Costmap,
     CostmapConfig,
-    circle_footprint,
-    footprint_radii,
     occupancy_values,
 )
+from tb3_navigation.footprint import circle_footprint, footprint_radii
 from tb3_sim_nav.world_file import Obstacle
 
 RESOLUTION = 0.05

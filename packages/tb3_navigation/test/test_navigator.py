@@ -8,8 +8,9 @@ import pytest
 
 from tb3_common.pose2d import compose, quaternion_of_yaw
 from tb3_harness.nav_sim import MAP_IN_ODOM, Lidar, Unicycle, costmaps, footprint_clearance, update_costmaps, world_cut
-from tb3_navigation.controller import Command, DwaController, dwa_config
+from tb3_navigation.controller import Command, DwaController
 from tb3_navigation.costmap import BURGER_FOOTPRINT
+from tb3_navigation.dwa_config import dwa_config
 from tb3_navigation.navigator import (
     ABORTED,
     CLEARING,

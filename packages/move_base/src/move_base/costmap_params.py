@@ -37,7 +37,8 @@ from tb3_common.params import (
     parameter,
     positive,
 )
-from tb3_navigation.costmap import CostmapConfig, circle_footprint
+from tb3_navigation.costmap import CostmapConfig
+from tb3_navigation.footprint import circle_footprint
 
 #: turtlebot3_navigation/param/global_costmap_params.yaml and local_costmap_params.yaml (noetic).
 GLOBAL_COSTMAP = dict(global_frame='map', robot_base_frame='base_footprint', update_frequency=10.0,

@@ -21,7 +21,7 @@ A value the node cannot honour is refused, as a bad value is: ParameterError
 import dataclasses
 
 from tb3_common.params import Checked, ParameterError, one_of, parameter
-from tb3_navigation.controller import DwaConfig
+from tb3_navigation.dwa_config import DwaConfig
 from tb3_navigation.navigator import NavigatorConfig
 from tb3_navigation.planner import PlannerConfig
 from tb3_navigation.recovery import RotateRecoveryConfig

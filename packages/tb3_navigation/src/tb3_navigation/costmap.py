@@ -32,7 +32,8 @@ and its radii come from it: the Burger's padded footprint is 0.166 x 0.23 m
 with base_footprint 0.051 m behind its front edge, so its inscribed radius
 is 0.051 m (a single cell's centre at 0.05 m is already outside it) and its
 circumscribed radius 0.163 m. A robot_radius instead of a footprint is
-costmap_2d's 16-corner polygon of it (circle_footprint).
+costmap_2d's 16-corner polygon of it (circle_footprint). The footprint's
+geometry is tb3_navigation.footprint's.
 """
 import math
 from dataclasses import dataclass
@@ -42,6 +43,7 @@ from scipy.ndimage import distance_transform_edt
 
 from tb3_common.grid import Grid
 from tb3_common.params import Checked, non_negative, number, parameter, points
+from tb3_navigation.footprint import footprint_radii, inside_convex, outline
 from tb3_navigation.raytrace import crossed_cells
 from tb3_navigation.scan import endpoints
 
@@ -81,35 +83,6 @@ class CostmapConfig(Checked):
         """The footprint (n, 2) pushed out by footprint_padding in x and y, as costmap_2d's padFootprint."""
         points = np.asarray(self.footprint, dtype=float)
         return points + np.sign(points) * self.footprint_padding
-
-
-def circle_footprint(radius):
-    """costmap_2d's makeFootprintFromRadius: the 16-corner polygon ((x, y), ...) it makes of
-    `robot_radius` when no footprint is given."""
-    angles = np.arange(16) * 2.0 * math.pi / 16
-    return tuple((float(math.cos(angle) * radius), float(math.sin(angle) * radius)) for angle in angles)
-
-
-def footprint_radii(footprint):
-    """(inscribed, circumscribed) radius of a footprint about its origin: the nearest
-    and the farthest of its edges and vertices (costmap_2d's calculateMinAndMaxDistances)."""
-    points = np.asarray(footprint, dtype=float)
-    starts, ends = points, np.roll(points, -1, axis=0)
-    along = ends - starts
-    share = np.clip(-np.sum(starts * along, axis=1) / np.maximum(np.sum(along * along, axis=1), 1e-300), 0.0, 1.0)
-    edges = np.hypot(*(starts + share[:, None] * along).T)
-    vertices = np.hypot(*points.T)
-    return float(min(edges.min(), vertices.min())), float(max(edges.max(), vertices.max()))
-
-
-def outline(footprint, spacing):
-    """Points (n, 2) along a footprint's edges, at most `spacing` apart, vertices included."""
-    points = np.asarray(footprint, dtype=float)
-    pieces = []
-    for start, end in zip(points, np.roll(points, -1, axis=0)):
-        count = max(1, int(math.ceil(math.hypot(*(end - start)) / spacing)))
-        pieces.append(start + (end - start) * (np.arange(count) / float(count))[:, None])
-    return np.concatenate(pieces)
 
 
 def inflation_costs(distance, resolution, inscribed_radius, inflation_radius, cost_scaling_factor):
@@ -331,7 +304,7 @@ class Costmap(object):
         box = np.stack((ix.ravel(), iy.ravel()), axis=-1)
         local = (self.grid.centres(box) - pose[:2]).dot(
             np.array([[math.cos(pose[2]), -math.sin(pose[2])], [math.sin(pose[2]), math.cos(pose[2])]]))
-        cells = np.concatenate((outline_cells, box[_inside_convex(self.footprint, local)]))
+        cells = np.concatenate((outline_cells, box[inside_convex(self.footprint, local)]))
         cells = cells[self.grid.inside(cells)]
         return np.unique(cells[:, 1] * self.grid.width + cells[:, 0])
 
@@ -355,12 +328,3 @@ class _Source(object):
         self.marking = self.clearing = True
         self.obstacle_range, self.raytrace_range = config.obstacle_range, config.raytrace_range
         self.inf_is_valid = config.inf_is_valid
-
-
-def _inside_convex(polygon, points):
-    """True where points (n, 2) lie inside a convex polygon (either winding)."""
-    polygon = np.asarray(polygon, dtype=float)
-    edges = np.roll(polygon, -1, axis=0) - polygon
-    relative = points[:, None, :] - polygon[None, :, :]
-    cross = edges[None, :, 0] * relative[..., 1] - edges[None, :, 1] * relative[..., 0]
-    return np.all(cross >= 0, axis=1) | np.all(cross <= 0, axis=1)
