@@ -1,202 +1,32 @@
 """move_base reads its parameters where and as move_base, costmap_2d and the planners read them (no ROS).
 
 The parameter server is faked by the tree a launch file's rosparam loads
-make (move_base.settings.Parameters over a dict): TurtleBot3's own files
-give TurtleBot3's values; the ROS wiki's navigation tutorial and ROS by
-Example's TurtleBot files (TrajectoryPlannerROS, robot_radius, frames
-written "/map", a 0.01 m costmap) are mapped onto this node's planner,
-controller and costmaps; a value that cannot be honoured is refused naming
-the parameter and the value; one taken without effect is named.
+make (move_base_param_trees.launch: move_base.settings.Parameters over a
+dict): TurtleBot3's own files give TurtleBot3's values; the ROS wiki's
+navigation tutorial and ROS by Example's TurtleBot files (TrajectoryPlannerROS,
+robot_radius, frames written "/map", a 0.01 m costmap) are mapped onto this
+node's planner, controller and costmaps; a value that cannot be honoured is
+refused naming the parameter and the value; one taken without effect is named;
+what dynamic_reconfigure may change carries the originals' names. The mapped
+values driving the whole stack: test_move_base_params_drive.py.
 """
 import math
-import os
-import time
 
 import numpy as np
 import pytest
 import yaml
+from move_base_param_trees import RBX1, WIKI, WIKI_COMMON, WIKI_GLOBAL, Recorder, launch, turtlebot3_files
 
 from move_base import planners
 from move_base.costmap_params import ObservationSource
 from move_base.live import live_names
-from move_base.settings import Parameters, construct, resolve, trajectory_dwa
+from move_base.settings import Parameters, resolve, trajectory_dwa
 from tb3_common.params import ParameterError
-from tb3_common.pose2d import compose
-from tb3_harness import nav_sim
-from tb3_navigation.controller import DwaController
-from tb3_navigation.costmap import BURGER_FOOTPRINT, Costmap, CostmapConfig
+from tb3_navigation.costmap import BURGER_FOOTPRINT, CostmapConfig
 from tb3_navigation.dwa_config import DwaConfig, dwa_config
 from tb3_navigation.footprint import circle_footprint, footprint_radii
-from tb3_navigation.navigator import SUCCEEDED, Navigator, NavigatorConfig
-from tb3_navigation.planner import GlobalPlanner, PlannerConfig
-
-PARAM = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'turtlebot3_navigation', 'param')
-
-# The ROS wiki's navigation tutorial (RobotSetup), filled in for a Burger; ROS by Example's
-# config/turtlebot values (rbx1 indigo-devel) in base_local_planner_params.yaml's layout.
-WIKI_COMMON = """
-obstacle_range: 2.5
-raytrace_range: 3.0
-robot_radius: 0.15
-inflation_radius: 0.55
-observation_sources: laser_scan_sensor
-laser_scan_sensor: {sensor_frame: base_scan, data_type: LaserScan, topic: scan, marking: true, clearing: true}
-"""
-WIKI_GLOBAL = """
-global_costmap:
-  global_frame: /map
-  robot_base_frame: base_footprint
-  update_frequency: 5.0
-  static_map: true
-"""
-WIKI_LOCAL = """
-local_costmap:
-  global_frame: odom
-  robot_base_frame: base_footprint
-  update_frequency: 5.0
-  publish_frequency: 2.0
-  static_map: false
-  rolling_window: true
-  width: 6.0
-  height: 6.0
-  resolution: 0.05
-"""
-WIKI_PLANNER = """
-TrajectoryPlannerROS:
-  max_vel_x: 0.45
-  min_vel_x: 0.1
-  max_vel_theta: 1.0
-  min_in_place_vel_theta: 0.4
-  acc_lim_theta: 3.2
-  acc_lim_x: 2.5
-  acc_lim_y: 2.5
-  holonomic_robot: false
-"""
-RBX1_COMMON = """
-obstacle_range: 2.5
-raytrace_range: 3.0
-robot_radius: 0.165
-inflation_radius: 0.3
-max_obstacle_height: 0.6
-min_obstacle_height: 0.0
-observation_sources: scan
-scan: {data_type: LaserScan, topic: /scan, marking: true, clearing: true, expected_update_rate: 0}
-"""
-RBX1_GLOBAL = """
-global_costmap:
-  global_frame: /map
-  robot_base_frame: /base_footprint
-  update_frequency: 1.0
-  publish_frequency: 0
-  static_map: true
-  rolling_window: false
-  resolution: 0.01
-  transform_tolerance: 1.0
-  map_type: costmap
-"""
-RBX1_LOCAL = """
-local_costmap:
-  global_frame: /odom
-  robot_base_frame: /base_footprint
-  update_frequency: 3.0
-  publish_frequency: 1.0
-  static_map: false
-  rolling_window: true
-  width: 6.0
-  height: 6.0
-  resolution: 0.01
-  transform_tolerance: 1.0
-  map_type: costmap
-"""
-RBX1_PLANNER = """
-controller_frequency: 3.0
-recovery_behavior_enabled: false
-clearing_rotation_allowed: false
-TrajectoryPlannerROS:
-  max_vel_x: 0.3
-  min_vel_x: 0.05
-  max_vel_y: 0.0
-  min_vel_y: 0.0
-  min_in_place_vel_theta: 0.5
-  escape_vel: -0.1
-  acc_lim_x: 2.5
-  acc_lim_y: 0.0
-  acc_lim_theta: 3.2
-  holonomic_robot: false
-  yaw_goal_tolerance: 0.1
-  xy_goal_tolerance: 0.1
-  latch_xy_goal_tolerance: false
-  pdist_scale: 0.8
-  gdist_scale: 0.6
-  meter_scoring: true
-  heading_lookahead: 0.325
-  heading_scoring: false
-  heading_scoring_timestep: 0.8
-  occdist_scale: 0.1
-  oscillation_reset_dist: 0.05
-  publish_cost_grid_pc: false
-  prune_plan: true
-  sim_time: 1.0
-  sim_granularity: 0.025
-  angular_sim_granularity: 0.025
-  vx_samples: 8
-  vy_samples: 0
-  vtheta_samples: 20
-  dwa: true
-  simple_attractor: false
-"""
-
-
-def merge(into, more):
-    for key, value in more.items():
-        if isinstance(value, dict) and isinstance(into.get(key), dict):
-            merge(into[key], value)
-        else:
-            into[key] = value
-    return into
-
-
-def launch(*loads, **params):
-    """The private tree of move_base after `<rosparam file=... ns=...>` for each (ns, YAML text) of
-    `loads`, then `<param name=... value=...>` for each of `params` (a name with '/' in it as written)."""
-    tree = {}
-    for namespace, text in loads:
-        loaded = yaml.safe_load(text)
-        merge(tree, {namespace: loaded} if namespace else loaded)
-    for name, value in params.items():
-        parts = name.split('/')
-        merge(tree, dict([(parts[0], value)]) if len(parts) == 1 else {parts[0]: dict([(parts[1], value)])})
-    return Parameters(tree)
-
-
-def turtlebot3_files():
-    """move_base.launch's loads of turtlebot3_navigation's param files (the Burger)."""
-    def text(name):
-        with open(os.path.join(PARAM, name)) as stream:
-            return stream.read()
-    common = text('costmap_common_params_burger.yaml')
-    return [('global_costmap', common), ('local_costmap', common), ('', text('local_costmap_params.yaml')),
-            ('', text('global_costmap_params.yaml')), ('', text('move_base_params.yaml')),
-            ('', text('dwa_local_planner_params_burger.yaml'))]
-
-
-class Recorder(object):
-    """A `read` that keeps what the node would warn about: {namespace: {name: why}}."""
-
-    def __init__(self):
-        self.unhonoured = {}
-
-    def __call__(self, config_class, namespace, values, unhonoured):
-        if unhonoured:
-            self.unhonoured.setdefault(namespace, {}).update(unhonoured)
-        return construct(config_class, namespace, values)
-
-
-WIKI = [('global_costmap', WIKI_COMMON), ('local_costmap', WIKI_COMMON), ('', WIKI_LOCAL), ('', WIKI_GLOBAL),
-        ('', WIKI_PLANNER)]
-RBX1 = [('global_costmap', RBX1_COMMON), ('local_costmap', RBX1_COMMON), ('', RBX1_LOCAL), ('', RBX1_GLOBAL),
-        ('', RBX1_PLANNER)]
-
+from tb3_navigation.navigator import NavigatorConfig
+from tb3_navigation.planner import PlannerConfig
 
 # --- TurtleBot3's launch: its values, unchanged ------------------------------------------------
 
@@ -408,64 +238,3 @@ def test_a_live_change_maps_as_at_start_and_a_bad_one_is_refused():
             resolved.trajectory.replace(**change)
     with pytest.raises(ParameterError, match='~inflation_radius = -0.1'):
         resolved.local_costmap.config.replace(inflation_radius=-0.1)
-
-
-# --- they drive: the wiki's TrajectoryPlannerROS around turtlebot3_world's pillars -------------
-
-START = (-2.0, -0.5, 0.0)
-GOALS = [(-0.55, -0.55, 0.0), (0.55, 0.55, math.pi / 2)]
-
-
-def test_the_wiki_tutorials_trajectory_planner_drives_around_the_pillars():
-    """The whole stack on the unicycle with the tutorial's TrajectoryPlannerROS values (its biases per
-    cell: no meter_scoring) and robot_radius, at move_base's controller_frequency (TurtleBot3's 10 Hz).
-    (ROS by Example's weights, per metre with occdist_scale 0.1, stop at the gap between the pillars and
-    turn in place: entering the gap costs 0.1 x 150 for the footprint's cells, more than the 0.6 x 0.3 m
-    one step nearer the goal saves. base_local_planner scores them the same way.)"""
-    resolved = resolve(launch(*WIKI, base_local_planner=planners.TRAJECTORY))
-    frequency = resolved.navigator.controller_frequency
-    dwa = trajectory_dwa(resolved.trajectory, 0.05, frequency, {})
-    obstacles = nav_sim.world_cut()
-    global_costmap, local_costmap = nav_sim.costmaps(obstacles, START, resolved.local_costmap.config)
-    navigator = Navigator(resolved.navigator, GlobalPlanner(resolved.planner), DwaController(local_costmap, dwa),
-                          global_costmap, local_costmap, resolved.rotation)
-    robot, lidar = nav_sim.Unicycle(START), nav_sim.Lidar(obstacles)
-    now = 0.0
-    for goal in GOALS:
-        navigator.set_goal(now, goal[:2] + (0.0,), (0.0, 0.0, math.sin(goal[2] / 2), math.cos(goal[2] / 2)))
-        outcome, least, since = None, math.inf, now
-        while outcome is None and now - since < 90.0:
-            nav_sim.update_costmaps(global_costmap, local_costmap, robot.pose, lidar.scan(robot.pose))
-            step = navigator.step(now, tuple(robot.pose), tuple(robot.velocity), nav_sim.MAP_IN_ODOM)
-            outcome = step.outcome
-            robot.run(step.cmd or (0.0, 0.0), 1.0 / frequency)
-            now += 1.0 / frequency
-            least = min(least, nav_sim.footprint_clearance(obstacles, BURGER_FOOTPRINT, robot.pose))
-        error = math.hypot(robot.pose[0] - goal[0], robot.pose[1] - goal[1])
-        print('MEASURED the wiki\'s TrajectoryPlannerROS to %s: %s in %.1f s, %.3f m off, footprint %.3f m from '
-              'the world' % (goal, outcome and outcome.status, now - since, error, least))
-        assert outcome is not None and outcome.status == SUCCEEDED
-        assert error <= dwa.xy_goal_tolerance and least > 0.05
-
-
-def test_a_local_costmap_at_0_01_m_works_and_what_it_costs():
-    """ROS by Example's 6 x 6 m local costmap at 0.01 m (360,000 cells) against TurtleBot3's 3 x 3 m at
-    0.05 m (3,600): one update and one command each, timed."""
-    obstacles = nav_sim.world_cut()
-    lidar = nav_sim.Lidar(obstacles)
-    pose = np.array(START)
-    plan = GlobalPlanner().make_plan(nav_sim.costmaps(obstacles, START)[0], START, GOALS[0])
-    times = {}
-    for size, resolution in ((3.0, 0.05), (6.0, 0.01)):
-        config = CostmapConfig(footprint=circle_footprint(0.165), inflation_radius=0.3)
-        costmap = Costmap.rolling(config, size, size, resolution, centre=pose[:2])
-        controller = DwaController(costmap, construct(DwaConfig, '', planners.dwa_of_trajectory_planner(
-            resolve(launch(*RBX1)).trajectory, resolution, 3.0)))
-        started = time.process_time()
-        costmap.update(pose, lidar.scan(pose), tuple(compose(pose, nav_sim.SCAN_POSE)))
-        updated = time.process_time()
-        command = controller.compute(pose, (0.0, 0.0), plan)
-        times[resolution] = (updated - started, time.process_time() - updated)
-        assert command.ok and command.v >= 0.0
-    print('MEASURED local costmap update / DWA command, CPU s: 3 x 3 m at 0.05 m %.3f / %.3f; 6 x 6 m at 0.01 m '
-          '%.3f / %.3f' % (times[0.05] + times[0.01]))
