@@ -1,66 +1,28 @@
 """tb3_navigation.slam on recorded drives of the simulated Burger (realistic profile: drifting odometry).
 
-The SLAM sees scans and odometry only; the true poses and the world file judge it.
+The SLAM sees scans and odometry only; the true poses and the world file judge it. Its answers to odd
+input (bad beams, odometry that jumps or slips, resets) are test_slam_input.py's.
 """
 import dataclasses
 import math
 
 import numpy as np
 import pytest
+from slam_drives import errors, obstacles, quality, run, scans_of
 
 from tb3_common.params import ParameterError
-from tb3_common.pose2d import IDENTITY, compose, normalize_angle, relative
-from tb3_harness import ROOT as REPO
-from tb3_harness.drives import HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, path_length, record_drive
+from tb3_common.pose2d import IDENTITY, compose, relative
+from tb3_harness.drives import HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP_START, path_length, record_drive
 from tb3_harness.map_quality import QualityConfig, measure
 from tb3_navigation.occupancy import OccupancyGrid
-from tb3_navigation.scan import Scan
 from tb3_navigation.slam import REDRAW_PER_SCAN, Slam, SlamConfig
-from tb3_sim_nav.world_file import load_world
+
+pytest_plugins = ['localization_drives']  # its loop
 
 #: turtlebot3_slam's gmapping_params.yaml (ROBOTIS-GIT/turtlebot3, noetic), the values we share.
 TURTLEBOT3_GMAPPING = dict(map_update_interval=2.0, maxUrange=3.0, sigma=0.05, lstep=0.05, astep=0.05,
                            iterations=5, lskip=0, minimumScore=50, linearUpdate=1.0, angularUpdate=0.2,
                            temporalUpdate=0.5, xmin=-10.0, ymin=-10.0, xmax=10.0, ymax=10.0, delta=0.05)
-
-
-def scans_of(drive, ranges=None):
-    ranges = drive.ranges if ranges is None else ranges
-    return [Scan(drive.angle_min, drive.angle_increment, r, drive.range_min, drive.range_max) for r in ranges]
-
-
-def run(drive, indices=None, odom=None, ranges=None, slam=None):
-    """Feed `drive`'s scans (those of `indices`, in that order, stamped 0.2 s apart) to a Slam;
-    returns it, the poses it gave and whether each scan was taken for a jump."""
-    slam = slam or Slam()
-    indices = range(len(drive.times)) if indices is None else indices
-    odom = drive.odom if odom is None else odom
-    scans = scans_of(drive, ranges)
-    poses, jumps = [], []
-    for step, index in enumerate(indices):
-        poses.append(slam.update(0.2 * step, odom[index], scans[index], drive.scan_pose))
-        jumps.append(slam.jumped)
-    return slam, np.array(poses), np.array(jumps)
-
-
-def errors(poses, truth):
-    """Distance (n,) and heading error (n,) of poses (n, 3) from the truth (n, 3)."""
-    return np.hypot(*(poses[:, :2] - truth[:, :2]).T), np.abs(normalize_angle(poses[:, 2] - truth[:, 2]))
-
-
-def obstacles(world):
-    return load_world(world, str(REPO / 'worlds')).obstacles
-
-
-def quality(slam, world, start):
-    """tb3_harness.map_quality's measures of the SLAM's map in `world`'s obstacles, from `start` (x, y)."""
-    return measure(slam.grid, slam.map_values(), world, start[:2])
-
-
-@pytest.fixture(scope='module')
-def loop():
-    """turtlebot3_world's loop of 13.6 m around the pillars; its odometry ends 18 cm and 2.8 degrees off."""
-    return record_drive('turtlebot3_world', WORLD_LOOP_START, WORLD_LOOP)
 
 
 @pytest.fixture(scope='module')
@@ -200,94 +162,6 @@ def test_the_same_input_gives_the_same_map(loop, loop_slam):
     second, again, _ = run(loop)
     assert np.array_equal(first.map_values(), second.map_values())
     assert np.array_equal(poses, again)
-
-
-def test_nan_and_infinite_beams_are_skipped_one_by_one(loop, world):
-    """A third of every scan's beams turned to NaN, +inf or -inf: the pose and the map
-    are as good as with the whole scans."""
-    rng = np.random.default_rng(12)
-    ranges = loop.ranges.copy()
-    spoilt = rng.random(ranges.shape) < 1 / 3
-    ranges[spoilt] = rng.choice([math.nan, math.inf, -math.inf], size=np.count_nonzero(spoilt))
-    slam, poses, _ = run(loop, ranges=ranges)
-    distance, turn = errors(poses, loop.truth)
-    assert distance.max() < 0.05 and turn.max() < math.radians(2.0)
-    assert quality(slam, world, WORLD_LOOP_START).occupied_near_surface >= 0.95
-
-
-def test_a_scan_with_too_few_valid_beams_does_not_move_the_pose(loop):
-    """Fewer valid beams than minimumScore (50) cannot make a match: the correction stays."""
-    slam, _, _ = run(loop, indices=range(60))
-    before = slam.map_to_odom
-    ranges = np.full(len(loop.ranges[60]), math.nan)
-    ranges[::8] = loop.ranges[60][::8]  # 45 beams left
-    scan = Scan(loop.angle_min, loop.angle_increment, ranges, loop.range_min, loop.range_max)
-    pose = slam.update(12.0, loop.odom[60], scan, loop.scan_pose)
-    assert not slam.matched
-    assert slam.map_to_odom == before
-    assert pose == pytest.approx(compose(before, loop.odom[60]))
-    blind = Scan(loop.angle_min, loop.angle_increment, np.full(360, math.nan), loop.range_min, loop.range_max)
-    values = slam.map_values()
-    slam.update(12.6, loop.odom[61], blind, loop.scan_pose)
-    assert slam.map_to_odom == before and np.array_equal(slam.map_values(), values)
-
-
-def test_a_teleport_the_odometry_saw_is_followed(loop):
-    """After most of the loop the robot is put back where it was 56 s earlier, and the
-    odometry jumps there too (with its drift of then: 14 cm and 2.7 degrees from where
-    the map has it): the map takes it there and follows it for 20 s more."""
-    indices = list(range(0, 381)) + list(range(100, 200))
-    _, poses, jumps = run(loop, indices=indices)
-    assert np.flatnonzero(jumps).tolist() == [381]
-    distance, turn = errors(poses, loop.truth[indices])
-    assert distance.max() < 0.05 and turn.max() < math.radians(2.0)
-
-
-def test_an_odometry_reset_in_place_does_not_move_the_pose(loop, world):
-    """At 40 s the odometry restarts from zero while the robot drives on: the pose in the
-    map goes on, map -> odom takes the jump."""
-    odom = loop.odom.copy()
-    odom[200:] = relative(loop.odom[200], loop.odom[200:])
-    slam, poses, jumps = run(loop, odom=odom)
-    assert np.flatnonzero(jumps).tolist() == [200]
-    distance, turn = errors(poses, loop.truth)
-    assert distance.max() < 0.05 and turn.max() < math.radians(2.0)
-    assert quality(slam, world, WORLD_LOOP_START).occupied_near_surface >= 0.95
-
-
-def test_bad_odometry_and_a_blind_first_scan_change_nothing(loop):
-    slam = Slam()
-    scans = scans_of(loop)
-    blind = Scan(loop.angle_min, loop.angle_increment, np.full(360, math.nan), loop.range_min, loop.range_max)
-    slam.update(0.0, loop.odom[0], blind, loop.scan_pose)
-    assert slam.map_updates == 0 and np.all(slam.map_values() == -1)
-    slam.update(0.2, loop.odom[1], scans[1], loop.scan_pose)
-    assert slam.map_updates == 1  # the first scan that shows something starts the map
-    pose, values = slam.pose, slam.map_values()
-    assert slam.update(0.4, (math.nan, 0.0, 0.0), scans[2], loop.scan_pose) == pose
-    assert slam.update(0.6, (0.0, math.inf, 0.0), scans[3], loop.scan_pose) == pose
-    assert np.array_equal(slam.map_values(), values) and slam.map_to_odom == IDENTITY
-
-
-def test_time_going_back_restarts_the_temporal_rule(loop):
-    """As when the simulation is reset and its clock starts again at 0."""
-    slam, _, _ = run(loop, indices=range(40))  # then straight on up the west side: no turn adds a scan
-    scans, added = scans_of(loop), []
-    for step, index in enumerate(range(40, 46)):
-        updates = slam.map_updates
-        slam.update(0.2 * step, loop.odom[index], scans[index], loop.scan_pose)
-        added.append(slam.map_updates - updates)
-    assert added == [0, 0, 0, 1, 0, 0]  # 0.6 s after the stamp that went back
-
-
-def test_reset_starts_a_new_map(loop):
-    slam, _, _ = run(loop, indices=range(30))
-    slam.reset()
-    assert slam.pose is None and slam.map_to_odom == IDENTITY
-    assert np.all(slam.map_values() == -1)
-    pose = slam.update(0.0, loop.odom[30], scans_of(loop)[30], loop.scan_pose)
-    assert pose == pytest.approx(tuple(loop.odom[30]))
-    assert np.count_nonzero(slam.map_values() == 100) > 100
 
 
 @pytest.mark.parametrize('config, motion, added', [

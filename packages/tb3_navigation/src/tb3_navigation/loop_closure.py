@@ -71,9 +71,9 @@ class LoopCloser(object):
     def add(self, pose, points, node, walls, jumped=False, search=True):
         """Adds the scan just added to the map at `pose`, `points` its end points (base frame);
         `walls()` gives the map's occupied cells (called only when a loop is searched for); `jumped`: the
-        odometry jumped before the scan (its step is then no measure); `search`: False while the map is
-        being drawn anew (its walls are not where the graph now puts them). Returns the pose corrected by
-        a loop closure (and then draws nothing: see draw), or None."""
+        odometry jumped or went astray since the last scan added (its step is then no measure);
+        `search`: False while the map is being drawn anew (its walls are not where the graph now puts
+        them). Returns the pose corrected by a loop closure (and then draws nothing: see draw), or None."""
         index = self.graph.add_pose(pose)
         self._nodes.append(node)
         if index == 0:

@@ -65,6 +65,12 @@ FIELD_SLACK = 0.5
 #: With odom_weight's 20 alone, those few points slid the pose along hallways the map had drawn a
 #: little off, and the map followed: 20 cm off in 50 s on perfect odometry (doc/speed.md).
 SURE = 150.0
+#: Share of a scan's points that must land on walls for a pose found at any heading (Slam._relocate): a
+#: scan matched where it belongs scores 0.8 of its points in the house, one 10 degrees off 0.43.
+RELOCATE_SHARE = 0.75
+#: ... and at least this share more than the pose the prediction matched: along a hallway a slide of
+#: 0.36 m scored a little more than the truth and would have been taken.
+RELOCATE_GAIN = 0.2
 #: After a loop closure the map is drawn anew from every scan of the graph, this many at each scan that
 #: comes in: all at once, a redraw on the drive round the outside of the house took 2 s of CPU in one
 #: scan's update, and a simulator in lockstep waits 0.5 s at most (doc/speed.md). Meanwhile the pose
@@ -158,6 +164,7 @@ class Slam(object):
         self.score = 0.0  # the last match's score (0: no match)
         self.matched = False  # whether the last scan's match was used
         self.jumped = False  # whether the odometry jumped before the last scan
+        self._astray = False  # whether the odometry jumped or went astray since the last scan added to the map
         self.map_updates = 0  # changes whenever the map does: a scan added, the map drawn anew
         self._redraw = None  # after a loop closure: [the map being drawn anew, how many scans it holds]
         self._odom = None
@@ -184,12 +191,18 @@ class Slam(object):
         if self.pose is not None:
             motion = relative(self._odom, odom)
             self.jumped = bool(math.hypot(motion[0], motion[1]) > c.jump_distance or abs(motion[2]) > c.jump_angle)
+            self._astray |= self.jumped
             if self._redraw is not None and self.jumped:
                 self._go_on_drawing(everything=True)  # a jump's two hypotheses are told apart by the map
             if self._redraw is None:
                 # After a jump, the pose before it is the other hypothesis: the odometry was reset in place.
                 priors = [predicted, self.pose] if self.jumped else [predicted]
-                pose = self._match(points, priors, widen=JUMP_SEARCH if self.jumped else 1) or predicted
+                pose = self._match(points, priors, widen=JUMP_SEARCH if self.jumped else 1)
+                if pose is None or self.score < RELOCATE_SHARE * len(points):
+                    found = self._relocate(points, self.pose, self.score)
+                    self._astray |= found is not None
+                    pose = found or pose
+                pose = pose or predicted
             step = relative(self.pose, pose)
             self._moved += math.hypot(step[0], step[1])
             self._turned += abs(step[2])
@@ -202,7 +215,8 @@ class Slam(object):
             self.map_updates += 1
             self._last_added, self._moved, self._turned = stamp, 0.0, 0.0
             closed = self.loops.add(pose, points, Node(scan, sensor_pose, max_range, odom),
-                                    lambda: self.map.occupied(c.occ_thresh), self.jumped, search=self._redraw is None)
+                                    lambda: self.map.occupied(c.occ_thresh), self._astray, search=self._redraw is None)
+            self._astray = False
             if closed is not None:
                 self._closed(closed)
                 return self.pose
@@ -266,6 +280,25 @@ class Slam(object):
         tells less of than SURE points' worth (along a corridor), the rest."""
         told, directions = np.linalg.eigh(equations[0] if equations is not None else np.zeros((3, 3)))
         return (directions * np.maximum(self.config.odom_weight, SURE - told)).dot(directions.T)
+
+    def _relocate(self, points, around, score):
+        """The pose when the prediction matched nothing though the scan has plenty to match (the wheels
+        turned on a robot held still, and the odometry with them): searched at any heading within the
+        jump's reach of `around`, and taken only where RELOCATE_SHARE of the points land on walls, and
+        RELOCATE_GAIN of them more than the `score` of the prediction's match. The odometry's steps since
+        are then no measure for the loop closer's chain."""
+        c = self.config
+        if len(points) < 2 * c.minimumScore:
+            return None
+        field = self._likelihood([around], JUMP_SEARCH)
+        if field.empty:
+            return None
+        start, _ = matcher.search(field, points, around, JUMP_SEARCH * c.search_linear, math.pi, c.lstep, c.astep)
+        pose, found = matcher.refine(field, points, start, JUMP_SEARCH * c.iterations)
+        if found < max(RELOCATE_SHARE, score / len(points) + RELOCATE_GAIN) * len(points):
+            return None
+        self.score, self.matched = found, True
+        return pose
 
     def _likelihood(self, priors, widen):
         """The likelihood field of the map around `priors`, made anew only when the set of occupied cells
