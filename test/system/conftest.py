@@ -7,6 +7,10 @@ from tb3_harness.screen import screen_env, start_xvfb
 
 from tb3_system_utils import MASTER_TIMEOUT, Processes, harness, master_uri, registered, wait_until
 
+# teleop_pty is both imported by the teleop's test files and their plugin (its fixtures): its asserts are
+# rewritten only if pytest knows it before they import it.
+pytest.register_assert_rewrite('teleop_pty')
+
 
 @pytest.fixture
 def ros_port(monkeypatch):

@@ -3,7 +3,7 @@ user's terminal runs it, against a roscore of each test's own on a free
 loopback port. What each must do is what the README says it does.
 
 test/unit/test_readme.py checks that every command the README shows is a
-literal of some test: these, test_teleop.py's, test_known_worlds.py's and
+literal of some test: these, the teleop's (teleop_pty.py), test_known_worlds.py's and
 test_own_workspace.py's; `make test` and `catkin_make run_tests` are in
 .ci/run and tools/run_tests.sh.
 """

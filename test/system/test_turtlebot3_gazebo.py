@@ -12,7 +12,7 @@ rviz opens on a screen of the test's own (Xvfb). Each launch ends with
 Ctrl+C as a terminal sends it (SIGINT to the launch's process group, so to
 roslaunch, which stops its nodes): every node of ours must be gone within
 2 s, and nothing the launch started may be left (tb3_harness.leftovers).
-(The teleop's launch is typed in test_teleop.py, which drives through a
+(The teleop's launch is typed in test_teleop_launch.py, which drives through a
 terminal.)
 """
 import math
