@@ -71,12 +71,26 @@ def shared_master(module_master):
     """The module's roscore, as a fresh one would be to a test that starts its
     own nodes: the parameters it started with, and only those, at the start of
     each test (a launch sets its parameters, and a test may set more; a node
-    never sees those of an earlier test). Its port."""
+    never sees those of an earlier test), and no node but rosout registered. Its port.
+
+    An earlier test's node that died without unregistering stays in the master
+    under its old address. When a node of the same name registers, the master
+    tells that address to shut down, and if the port has since been reused by
+    another process (in CI, once: a `rostopic echo`), that one obeys. So the
+    leftovers are unregistered first, as `rosnode cleanup` does."""
+    import contextlib
+    import io
+
     import rosgraph
+    import rosnode
     port, baseline = module_master
     assert os.environ['ROS_MASTER_URI'] == master_uri(port)
     server = rosgraph.Master('/tb3_test')
     for name in sorted(set(server.getParamNames()) - baseline):
         if server.hasParam(name):   # gone with a namespace deleted before it
             server.deleteParam(name)
+    leftovers = set(rosnode.get_node_names()) - {'/rosout'}
+    with contextlib.redirect_stdout(io.StringIO()):  # it prints a line per node
+        rosnode.cleanup_master_blacklist(server, sorted(leftovers))
+    assert set(rosnode.get_node_names()) == {'/rosout'}, rosnode.get_node_names()
     return port

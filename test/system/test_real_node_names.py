@@ -296,7 +296,8 @@ def test_a_node_started_before_the_world_says_it_keeps_wall_time(ros_port, proce
     assert wait_until(lambda: 'started before /use_sim_time was set' in early.output(None), 30.0), early.output()
     late = processes.start('late', ['rosrun', 'fake_localization', 'fake_localization'], env=_burger())
     assert wait_until(lambda: registered(master, '/fake_localization'), 60.0), late.output()
-    subscribers = dict(master.getSystemState()[1])
-    assert '/fake_localization' in subscribers.get('/clock', ()), 'the late node is not on sim time'
+    # rospy registers the node (its /rosout publisher) before it subscribes to /clock: CI once looked in between.
+    assert wait_until(lambda: '/fake_localization' in dict(master.getSystemState()[1]).get('/clock', ()), 30.0), \
+        'the late node is not on sim time'
     time.sleep(2.0)  # /clock at 100 Hz has reached it 200 times meanwhile
     assert 'use_sim_time' not in late.output(None), late.output()
