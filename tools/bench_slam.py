@@ -21,6 +21,7 @@ import numpy as np
 from tb3_common.pose2d import normalize_angle
 from tb3_harness import ROOT
 from tb3_harness.drives import HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, path_length, record_drive
+from tb3_harness.map_quality import QualityConfig
 from tb3_harness.map_quality import measure as map_quality
 from tb3_navigation.scan import Scan
 from tb3_navigation.slam import Slam
@@ -63,13 +64,15 @@ def measure(name):
     poses, cpu = np.array(poses), np.array(cpu) * 1000.0
     distance, turn = errors(poses, drive.truth)
     odom_distance, odom_turn = errors(drive.odom, drive.truth)
-    quality = map_quality(slam.grid, slam.map_values(), load_world(world, os.path.join(ROOT, 'worlds')).obstacles,
-                          start[:2])
+    obstacles = load_world(world, os.path.join(ROOT, 'worlds')).obstacles
+    quality = map_quality(slam.grid, slam.map_values(), obstacles, start[:2])
+    near05 = map_quality(slam.grid, slam.map_values(), obstacles, start[:2], QualityConfig(tolerance=0.05))
     return dict(drive=name, scans=len(cpu), metres=path_length(drive.truth),
                 cpu_median=np.median(cpu), cpu_p95=np.percentile(cpu, 95), cpu_mean=cpu.mean(), cpu_max=cpu.max(),
                 end_cm=100 * distance[-1], end_deg=turn[-1], worst_cm=100 * distance.max(), worst_deg=turn.max(),
                 odom_end_cm=100 * odom_distance[-1], odom_end_deg=odom_turn[-1],
-                near=100 * quality.occupied_near_surface, covered=100 * quality.surface_covered,
+                near05=100 * near05.occupied_near_surface, near=100 * quality.occupied_near_surface,
+                covered=100 * quality.surface_covered,
                 thickness=quality.wall_thickness, thicker=100 * quality.thick_wall_share,
                 doubled=100 * quality.doubled_wall_share)
 
@@ -78,8 +81,8 @@ def measure(name):
 COLUMNS = [('drive', 6, '%s'), ('scans', 6, '%d'), ('metres', 7, '%.1f'), ('cpu_median', 11, '%.1f'),
            ('cpu_p95', 8, '%.1f'), ('cpu_mean', 9, '%.1f'), ('cpu_max', 8, '%.1f'), ('end_cm', 7, '%.1f'),
            ('end_deg', 8, '%.2f'), ('worst_cm', 9, '%.1f'), ('worst_deg', 10, '%.2f'), ('odom_end_cm', 12, '%.1f'),
-           ('odom_end_deg', 13, '%.2f'), ('near', 6, '%.1f'), ('covered', 8, '%.1f'), ('thickness', 10, '%.1f'),
-           ('thicker', 8, '%.1f'), ('doubled', 8, '%.1f')]
+           ('odom_end_deg', 13, '%.2f'), ('near05', 7, '%.1f'), ('near', 6, '%.1f'), ('covered', 8, '%.1f'),
+           ('thickness', 10, '%.1f'), ('thicker', 8, '%.1f'), ('doubled', 8, '%.1f')]
 
 
 def main():
@@ -90,8 +93,8 @@ def main():
         datetime.date.today(), platform.node(), platform.processor() or platform.machine(), os.cpu_count(),
         os.getloadavg()[0]))
     print('# cpu: ms of process time per Slam.update; cm/deg: pose against the truth; map (tb3_harness.map_quality, '
-          '%): occupied cells near a surface, surface covered (of the whole world), wall thickness (median cells), '
-          'walls thicker than 2 cells, doubled')
+          '%): occupied cells within 0.05 and 0.10 m of a surface, surface covered (of the whole world), wall '
+          'thickness (median cells), walls thicker than 2 cells, doubled')
     print(' '.join(key.rjust(width) for key, width, _ in COLUMNS))
     for name in args.drives.split(','):
         row = measure(name.strip())

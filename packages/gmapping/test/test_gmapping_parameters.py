@@ -33,8 +33,8 @@ def test_every_parameter_of_slam_gmapping_is_taken_once():
 
 
 def test_only_the_particle_filters_parameters_are_unhonoured_and_each_says_why():
-    assert set(UNHONOURED) == {'particles', 'resampleThreshold', 'srr', 'srt', 'str', 'stt', 'ogain', 'lsigma',
-                               'kernelSize', 'llsamplerange', 'llsamplestep', 'lasamplerange', 'lasamplestep'}
+    assert set(UNHONOURED) == {'particles', 'resampleThreshold', 'ogain', 'lsigma', 'kernelSize', 'llsamplerange',
+                               'llsamplestep', 'lasamplerange', 'lasamplestep'}
     assert all(len(why) > 20 for why in UNHONOURED.values())
 
 

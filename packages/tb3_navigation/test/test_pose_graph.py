@@ -4,7 +4,9 @@ import math
 import numpy as np
 
 from tb3_common.pose2d import compose, relative
+from tb3_navigation.loop_closure import information
 from tb3_navigation.pose_graph import PoseGraph
+from tb3_navigation.slam import SlamConfig
 
 INFORMATION = np.diag([2500.0, 2500.0, 10000.0])
 
@@ -61,3 +63,33 @@ def test_without_constraints_nothing_moves():
     graph.add_pose((0.0, 0.0, 0.0))
     graph.add_pose((1.0, 0.0, 0.0))
     assert graph.optimize() == 0.0 and graph.edges == 0 and len(graph) == 2
+
+
+def test_a_closure_puts_the_correction_where_the_pose_followed_the_odometry():
+    """The drift of a square came from one turn no scan matched (3 degrees of wheel slip): with that
+    step's constraint weighed by gmapping's odometry model (loop_closure.information), the closure
+    turns it back there and every pose lands on the truth; weighed as a matched one, the correction is
+    spread over the whole loop and the far side stays off (measured: 0.5 and 4.8 cm)."""
+    truth = square()
+    corner = 24  # the first turn: step 24 -> 25
+    steps = [relative(before, after) for before, after in zip(truth[:-1], truth[1:])]
+    steps[corner] = (steps[corner][0], steps[corner][1], steps[corner][2] + math.radians(3.0))
+    drifted = [tuple(truth[0])]
+    for step in steps:
+        drifted.append(tuple(compose(drifted[-1], step)))
+    config = SlamConfig()
+    worst = {}
+    for weighed in (False, True):
+        graph = PoseGraph()
+        for pose in drifted:
+            graph.add_pose(pose)
+        for i, step in enumerate(steps):
+            followed = (math.hypot(step[0], step[1]), abs(step[2])) if weighed and i == corner else (0.0, 0.0)
+            graph.add_edge(i, i + 1, step, information(config, *followed))
+        last = len(truth) - 1
+        graph.add_edge(last, 0, relative(truth[last], truth[0]), information(config))
+        graph.optimize()
+        worst[weighed] = np.hypot(*(graph.poses[:, :2] - truth[:, :2]).T).max()
+    print('MEASURED worst pose after the closure: %.1f cm weighed as matched, %.1f cm by the odometry model'
+          % (100 * worst[False], 100 * worst[True]))
+    assert worst[True] < 0.01 < 0.04 < worst[False]

@@ -5,8 +5,9 @@ gmapping/src/slam_gmapping.cpp, the version Noetic ships) is taken here, so
 that a launch file written for gmapping (ROBOTIS' gmapping_params.yaml, its
 multi-robot launch) runs unchanged:
 
-- the SLAM's own (maxUrange, delta, linearUpdate, minimumScore...) are
-  tb3_navigation.slam.SlamConfig's fields, honoured there;
+- the SLAM's own (maxUrange, delta, linearUpdate, minimumScore, the
+  odometry error model srr..stt...) are tb3_navigation.slam.SlamConfig's
+  fields, honoured there;
 - the wrapper's (frames, throttle_scans, transform_publish_period,
   tf_delay) are NodeConfig's below, honoured by the node;
 - those of gmapping's particle filter mean nothing to a SLAM that keeps one
@@ -22,14 +23,12 @@ from tb3_common.params import Checked, non_negative, number, one_of, optional_fr
 METHODS = ('tb3', 'gmapping', 'cartographer', 'hector', 'karto', 'frontier_exploration')
 
 _PARTICLES = 'this SLAM keeps one pose, matched once per scan, not a particle filter'
-_MOTION = "the particles' motion noise; the one pose here is predicted by odometry and corrected by the match"
 _SAMPLING = "the sampling of a particle's likelihood around its match; the match here is refined by Gauss-Newton"
 
 #: gmapping's parameters this node takes without effect: name -> why.
 UNHONOURED = {
     'particles': _PARTICLES,
     'resampleThreshold': _PARTICLES + ': nothing to resample',
-    'srr': _MOTION, 'srt': _MOTION, 'str': _MOTION, 'stt': _MOTION,
     'ogain': "it smooths the particles' weights; " + _PARTICLES,
     'lsigma': "a beam's noise in the particles' weights; the match here scores beams by sigma",
     'kernelSize': "gmapping's matcher looks this many cells round a beam's end for a hit; the match here "

@@ -82,9 +82,11 @@ REDRAW_PER_SCAN = 50
 class SlamConfig(Checked):
     """gmapping's parameters (its names) with turtlebot3_slam's values, and the few of our own.
 
-    gmapping's particle filter's own (particles, srr, srt, str, stt,
-    resampleThreshold, ogain, lsigma, kernelSize, ll/lasample*) mean nothing
-    here: the node (gmapping.node) takes them and says so. odom_weight 20:
+    gmapping's particle filter's own (particles, resampleThreshold, ogain,
+    lsigma, kernelSize, ll/lasample*) mean nothing here: the node
+    (gmapping.node) takes them and says so. Its odometry error model (srr,
+    srt, str, stt) weighs the pose graph's constraints where the pose
+    followed the odometry, as it spreads gmapping's particles. odom_weight 20:
     the worst pose error on the house tour was 6.4 cm with 0, 2.4 cm with 20,
     5.4 cm with 80.
     """
@@ -120,6 +122,12 @@ class SlamConfig(Checked):
                                      positive, 'm')
     jump_angle: float = parameter(1.0, 'rad, likewise (the Burger turns at most 2.84 rad/s: 0.57 rad in 0.2 s)',
                                   positive, 'rad')
+    # gmapping's odometry error model: how far the graph's constraints trust a stretch the pose followed the
+    # odometry unmatched (tb3_navigation.loop_closure.information).
+    srr: float = parameter(0.1, 'odometry error in translation as a function of translation (m/m)', non_negative)
+    srt: float = parameter(0.2, 'odometry error in translation as a function of rotation (m/rad)', non_negative)
+    str: float = parameter(0.1, 'odometry error in rotation as a function of translation (rad/m)', non_negative)
+    stt: float = parameter(0.2, 'odometry error in rotation as a function of rotation (rad/rad)', non_negative)
     # Loop closure (tb3_navigation.loop_closure), under slam_toolbox's names where they mean the same.
     do_loop_closing: bool = parameter(True, 'match a scan that comes back near old ones against them and correct '
                                             'the poses since and the map')
@@ -165,6 +173,7 @@ class Slam(object):
         self.matched = False  # whether the last scan's match was used
         self.jumped = False  # whether the odometry jumped before the last scan
         self._astray = False  # whether the odometry jumped or went astray since the last scan added to the map
+        self._followed = np.zeros(2)  # m and rad the pose followed the odometry unmatched since then
         self.map_updates = 0  # changes whenever the map does: a scan added, the map drawn anew
         self._redraw = None  # after a loop closure: [the map being drawn anew, how many scans it holds]
         self._odom = None
@@ -206,6 +215,8 @@ class Slam(object):
             step = relative(self.pose, pose)
             self._moved += math.hypot(step[0], step[1])
             self._turned += abs(step[2])
+            if not self.matched:
+                self._followed += (math.hypot(motion[0], motion[1]), abs(motion[2]))
         if self.matched:
             self.map_to_odom = tuple(compose(pose, inverse(odom)))
         self.pose, self._odom = pose, odom
@@ -215,8 +226,9 @@ class Slam(object):
             self.map_updates += 1
             self._last_added, self._moved, self._turned = stamp, 0.0, 0.0
             closed = self.loops.add(pose, points, Node(scan, sensor_pose, max_range, odom),
-                                    lambda: self.map.occupied(c.occ_thresh), self._astray, search=self._redraw is None)
-            self._astray = False
+                                    lambda: self.map.occupied(c.occ_thresh), self._astray, search=self._redraw is None,
+                                    followed=tuple(self._followed))
+            self._astray, self._followed = False, np.zeros(2)
             if closed is not None:
                 self._closed(closed)
                 return self.pose
@@ -282,8 +294,9 @@ class Slam(object):
         return (directions * np.maximum(self.config.odom_weight, SURE - told)).dot(directions.T)
 
     def _relocate(self, points, around, score):
-        """The pose when the prediction matched nothing though the scan has plenty to match (the wheels
-        turned on a robot held still, and the odometry with them): searched at any heading within the
+        """The pose when the prediction matched nothing, or put less than RELOCATE_SHARE of the points on
+        walls, though the scan has plenty to match (the wheels turned on a robot held still, and the
+        odometry with them): searched at any heading within the
         jump's reach of `around`, and taken only where RELOCATE_SHARE of the points land on walls, and
         RELOCATE_GAIN of them more than the `score` of the prediction's match. The odometry's steps since
         are then no measure for the loop closer's chain."""
