@@ -93,7 +93,12 @@ class SlamNode(object):
                 self.slam.reset()
                 self._last_map_stamp, self._published_updates = None, -1
             self._last_stamp = stamp
+            closures = self.slam.loops.closures
             self.slam.update(stamp.to_sec(), odom, Scan.from_message(message), sensor)
+            if self.slam.loops.closures != closures:
+                rospy.loginfo('%s: a loop closed at %.2f s: the graph of %d scans moved a pose by %.2f m or rad at '
+                              'most; the map is drawn anew', self.name, stamp.to_sec(), len(self.slam.loops.graph),
+                              self.slam.loops.moved)
             if self.slam.jumped:
                 rospy.loginfo('%s: the odometry jumped (a reset or a teleport) at %.2f s; the pose in %s is '
                               '(%.2f, %.2f, %.2f), matched: %s', self.name, stamp.to_sec(), self.map_frame,

@@ -69,6 +69,7 @@ class LoopCloser(object):
         self._travelled = []  # m driven, along the chain of scans, to each scan
         self._searched_at = -math.inf  # m driven at the last search
         self.closures = 0  # loops closed that moved the poses
+        self.moved = 0.0  # m or rad the last of them moved a pose at most
 
     def add(self, pose, points, node, walls, jumped=False, search=True, followed=(0.0, 0.0)):
         """Adds the scan just added to the map at `pose`, `points` its end points (base frame);
@@ -103,7 +104,7 @@ class LoopCloser(object):
         self.graph.add_edge(old, index, relative(self.graph.poses[old], matched), information(self.config))
         if not _differ(np.abs(self.graph.errors()).max(axis=0), (0.0, 0.0, 0.0), NEGLIGIBLE):
             return None
-        self.graph.optimize()
+        self.moved = self.graph.optimize()
         self.closures += 1
         return tuple(self.graph.poses[index])
 
