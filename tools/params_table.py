@@ -9,7 +9,7 @@ import sys
 from tb3_sim_nav.params import FROM_MODEL, FROM_PROFILE, PARAMETERS, PROFILES
 
 #: (node, parameter namespace, config class) of the navigation nodes, in doc/reference.md's order.
-NAVIGATION = [('slam_gmapping', '', 'tb3_navigation.slam.SlamConfig'),
+NAVIGATION = [('slam_gmapping', '', 'tb3_navigation.slam_config.SlamConfig'),
               ('slam_gmapping', '', 'gmapping.config.NodeConfig'),
               ('amcl', '', 'tb3_navigation.amcl_config.AmclConfig'),
               ('amcl', '', 'amcl.config.AmclNodeConfig'),

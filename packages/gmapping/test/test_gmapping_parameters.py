@@ -5,7 +5,7 @@ import pytest
 
 from gmapping.config import METHODS, UNHONOURED, NodeConfig
 from tb3_common.params import ParameterError
-from tb3_navigation.slam import SlamConfig
+from tb3_navigation.slam_config import SlamConfig
 
 #: Every parameter ros-perception/slam_gmapping 1.4.2 (Noetic's) reads in gmapping/src/slam_gmapping.cpp.
 WRAPPER = ('throttle_scans', 'base_frame', 'map_frame', 'odom_frame', 'transform_publish_period',

@@ -6,7 +6,7 @@ import numpy as np
 from tb3_common.pose2d import compose, relative
 from tb3_navigation.loop_closure import information
 from tb3_navigation.pose_graph import PoseGraph
-from tb3_navigation.slam import SlamConfig
+from tb3_navigation.slam_config import SlamConfig
 
 INFORMATION = np.diag([2500.0, 2500.0, 10000.0])
 

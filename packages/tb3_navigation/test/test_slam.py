@@ -15,7 +15,8 @@ from tb3_common.pose2d import IDENTITY, compose, relative
 from tb3_harness.drives import HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP_START, path_length, record_drive
 from tb3_harness.map_quality import QualityConfig, measure
 from tb3_navigation.occupancy import OccupancyGrid
-from tb3_navigation.slam import REDRAW_PER_SCAN, Slam, SlamConfig
+from tb3_navigation.slam import REDRAW_PER_SCAN, Slam
+from tb3_navigation.slam_config import SlamConfig
 
 pytest_plugins = ['localization_drives']  # its loop
 

@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 from gmapping.config import METHODS, UNHONOURED
-from tb3_navigation.slam import SlamConfig
+from tb3_navigation.slam_config import SlamConfig
 
 PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ROBOTIS_METHODS = ('gmapping', 'cartographer', 'hector', 'karto', 'frontier_exploration')

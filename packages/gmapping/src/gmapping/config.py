@@ -6,7 +6,7 @@ that a launch file written for gmapping (ROBOTIS' gmapping_params.yaml, its
 multi-robot launch) runs unchanged:
 
 - the SLAM's own (maxUrange, delta, linearUpdate, minimumScore, the
-  odometry error model srr..stt...) are tb3_navigation.slam.SlamConfig's
+  odometry error model srr..stt...) are tb3_navigation.slam_config.SlamConfig's
   fields, honoured there;
 - the wrapper's (frames, throttle_scans, transform_publish_period,
   tf_delay) are NodeConfig's below, honoured by the node;

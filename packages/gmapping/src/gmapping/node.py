@@ -29,7 +29,8 @@ from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import Frames, namespaced
 from tb3_common.ros.map_messages import occupancy_grid
 from tb3_navigation.scan import Scan
-from tb3_navigation.slam import Slam, SlamConfig
+from tb3_navigation.slam import Slam
+from tb3_navigation.slam_config import SlamConfig
 
 NODE = 'slam_gmapping'  # gmapping's own name for it; a launch file gives another (tb3_slam, turtlebot3_slam_gmapping)
 

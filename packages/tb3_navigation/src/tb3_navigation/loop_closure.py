@@ -58,7 +58,7 @@ Node = namedtuple('Node', 'scan sensor_pose max_range odom')
 
 class LoopCloser(object):
     """The pose graph of the scans added to a map, and the search for loops among them. `config` is
-    the SLAM's (tb3_navigation.slam.SlamConfig)."""
+    the SLAM's (tb3_navigation.slam_config.SlamConfig)."""
 
     def __init__(self, config, grid):
         """`grid`: the map's (tb3_common.grid.Grid)."""
