@@ -55,12 +55,14 @@ def explore_rows(explored, navigated):
     navigated on the first map (what `make demo DEMO_ARGS=--explore` does)."""
     lines = ['turtlebot3_house explored (tb3_slam.launch explore:=true, profile realistic), factor 0, one run each:']
     for label, run in explored.items():
-        quality = run.quality
+        quality, still = run.quality, exploring.stood_still(run.truth)
         lines += ['  %s:' % label,
                   '%-58s %12s' % ('    goals sent, blacklisted', '%d, %d' % (run.goals, run.blacklisted)),
                   '%-58s %5.0f s / %.0f s' % ('    sim / wall time (the launches included)', run.sim_seconds,
                                               run.wall_seconds),
                   '%-58s %12.1f' % ('    real-time factor', run.sim_seconds / run.wall_seconds),
+                  '%-58s %12s' % ('    stood still (0.2 m for 20 s or more): times, sim s',
+                                  '%d, %.0f s' % (len(still), sum(seconds for _, seconds, _ in still))),
                   '%-58s %5.1f / %.1f %%' % ('    occupied cells within 0.05 / 0.10 m of a surface',
                                              100 * strict(run).occupied_near_surface,
                                              100 * quality.occupied_near_surface),

@@ -9,6 +9,7 @@ from scipy import ndimage
 
 from tb3_common.grid import Grid
 from tb3_common.map_files import load_map
+from tb3_harness.exploring import stood_still
 from tb3_harness.map_quality import QualityConfig, measure, render_png
 from tb3_navigation.raytrace import crossed_cells, end_cells
 from tb3_navigation.scan import Scan
@@ -202,3 +203,15 @@ def test_bounds_keep_the_free_floor_measure_to_a_box(world, perfect):
           % (whole.free_floor_mapped, east.free_floor_mapped))
     assert 0.4 < whole.free_floor_mapped < 0.6
     assert east.free_floor_mapped == 1.0 and east.reachable_cells < 0.6 * whole.reachable_cells
+
+
+def test_stood_still_finds_the_spells_a_path_stayed_put_and_only_those():
+    # 10 s driving, 30 s within 5 cm (a robot rocking on its recoveries), 10 s driving, 15 s still (too short).
+    path = [[t, 0.1 * t, 0.0] for t in range(10)]
+    path += [[10 + t, 1.0 + 0.05 * (t % 2), 0.0] for t in range(31)]
+    path += [[41 + t, 1.1 + 0.1 * t, 0.0] for t in range(1, 11)]
+    path += [[51 + t, 2.1, 0.0] for t in range(16)]
+    spells = stood_still(path)
+    assert len(spells) == 1
+    start, seconds, where = spells[0]
+    assert 9 <= start <= 10 and 30 <= seconds <= 32 and abs(where[0] - 1.0) < 0.11, spells

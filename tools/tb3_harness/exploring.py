@@ -31,6 +31,9 @@ DONE = re.compile(r'\[([0-9.]+) s\] exploration done: (.*?)\. Explored ([0-9.]+)
                   r'([0-9]+) % .*?; ([0-9]+) goals sent in ([0-9.]+) s, ([0-9]+) blacklisted')
 GOAL = re.compile(r'explore: \[([0-9.]+) s\] goal ([0-9]+) \(')
 GOAL_LINE = re.compile(r'explore: (\[[0-9.]+ s\] goal [0-9]+ .*)')
+#: A robot that stays within STILL_REACH m of one spot for STILL_LEAST s of sim time or more stands still:
+#: move_base's recoveries, goals given up after explore's progress_timeout (30 s).
+STILL_REACH, STILL_LEAST = 0.2, 20.0
 
 
 @dataclasses.dataclass
@@ -62,10 +65,28 @@ class ExplorationRun(object):
                        bounds=world_map.bounds(world_map.in_plane(self.obstacles)))
 
     def summary(self):
+        still = stood_still(self.truth)
         return ('%s explored in %.1f s of sim time (%.1f s wall at factor %g): %d goals, %d blacklisted; %s; '
-                'footprint at least %.3f m from the world; %s' % (
+                'stood still %d times, %.0f s in all; footprint at least %.3f m from the world; %s' % (
                     self.world, self.sim_seconds, self.wall_seconds, self.factor, self.goals, self.blacklisted,
-                    self.done_text, self.clearance, self.quality.summary()))
+                    self.done_text, len(still), sum(seconds for _, seconds, _ in still), self.clearance,
+                    self.quality.summary()))
+
+
+def stood_still(path, reach=STILL_REACH, least=STILL_LEAST):
+    """Where a path [[t, x, y, ...], ...] (sim s, m) stayed within `reach` m of where it was at a time for
+    `least` s or more: [(start, seconds, (x, y))], in order."""
+    spells, first = [], 0
+    while first < len(path):
+        last = first
+        while last + 1 < len(path) and math.hypot(path[last + 1][1] - path[first][1],
+                                                  path[last + 1][2] - path[first][2]) < reach:
+            last += 1
+        seconds = path[last][0] - path[first][0]
+        if seconds >= least:
+            spells.append((path[first][0], seconds, (path[first][1], path[first][2])))
+        first = last + 1
+    return spells
 
 
 def _read(path):
