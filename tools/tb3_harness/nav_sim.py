@@ -5,14 +5,19 @@ A unicycle with TurtleBot3's acceleration limits stands for the Burger, a
 for its LDS-01 (360 beams, 0.12-3.5 m, sigma 0.01 m, seeded), and the map is
 the cut as world_map.map_of_world draws it for the shipped maps. The odom
 frame is set off from the map frame, so that the cores meet two frames as on
-the robot.
+the robot. `stack` and `run_stack` drive move_base's cores (costmaps,
+planner, DWA, state machine) with TurtleBot3's values in that loop.
 """
 import math
 
 import numpy as np
 
 from tb3_common.pose2d import compose, inverse
-from tb3_navigation.costmap import Costmap, CostmapConfig
+from tb3_navigation.controller import DwaController
+from tb3_navigation.costmap import BURGER_FOOTPRINT, Costmap, CostmapConfig
+from tb3_navigation.dwa_config import dwa_config
+from tb3_navigation.navigator import Navigator, NavigatorConfig
+from tb3_navigation.planner import GlobalPlanner, PlannerConfig
 from tb3_navigation.scan import Scan
 from tb3_sim_nav import world_map
 from tb3_sim_nav.world_file import load_world
@@ -22,6 +27,7 @@ from . import ROOT as REPO
 SCAN_POSE = (-0.032, 0.0, 0.0)  # base_scan in base_footprint (Burger)
 BEAMS, RANGE_MIN, RANGE_MAX, SIGMA = 360, 0.12, 3.5, 0.01
 MAP_IN_ODOM = (0.3, -0.2, 0.1)  # the map frame's pose in odom: any fixed offset will do
+PERIOD = 0.1  # s: move_base's controller_frequency (TurtleBot3's 10 Hz); scans come every other period
 
 
 def world_cut(world='turtlebot3_world'):
@@ -103,3 +109,34 @@ def odom_of(pose):
 
 def map_of_odom(pose):
     return compose(inverse(MAP_IN_ODOM), pose)
+
+
+def stack(obstacles, start, planner_config=PlannerConfig()):
+    """(move_base's Navigator with TurtleBot3's values, its global costmap, its local one) for a robot at `start`."""
+    global_costmap, local_costmap = costmaps(obstacles, start)
+    navigator = Navigator(NavigatorConfig(), GlobalPlanner(planner_config), DwaController(local_costmap, dwa_config()),
+                          global_costmap, local_costmap)
+    return navigator, global_costmap, local_costmap
+
+
+def run_stack(navigator, global_costmap, local_costmap, robot, lidar, seconds, judged=None, poses=None):
+    """Steps the stack at 10 Hz (scans at 5 Hz) until an outcome; (outcome, steps, the
+    closest approach of the robot's footprint to each of the `judged` groups of obstacles
+    (default: all the lidar sees)). `poses`, a list: the robot's pose after each period is added."""
+    judged = judged or dict(all=lidar.obstacles)
+    now, steps, clearance = 0.0, [], dict((name, math.inf) for name in judged)
+    for tick in range(int(round(seconds / PERIOD))):
+        if tick % 2 == 0:
+            update_costmaps(global_costmap, local_costmap, robot.pose, lidar.scan(robot.pose))
+        step = navigator.step(now, tuple(robot.pose), tuple(robot.velocity), MAP_IN_ODOM)
+        steps.append(step)
+        if step.outcome is not None:
+            return step.outcome, steps, clearance
+        assert step.cmd is not None and all(math.isfinite(value) for value in step.cmd)
+        robot.run(step.cmd, PERIOD)
+        now += PERIOD
+        if poses is not None:
+            poses.append(robot.pose.copy())
+        for name, group in judged.items():
+            clearance[name] = min(clearance[name], footprint_clearance(group, BURGER_FOOTPRINT, robot.pose))
+    return None, steps, clearance

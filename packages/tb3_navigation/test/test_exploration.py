@@ -17,7 +17,7 @@ from tb3_harness.explore_sim import ExploreLoop
 from tb3_harness.map_quality import measure
 from tb3_navigation.costmap import Costmap, CostmapConfig
 from tb3_navigation.exploration import ABORTED, DONE, KEEP, SEND, SUCCEEDED, WAIT, Explorer
-from tb3_navigation.frontiers import FrontierSearch
+from tb3_navigation.frontiers import NAVFN, FrontierSearch
 from tb3_navigation.occupancy import OccupancyGrid
 from tb3_navigation.planner import GlobalPlanner, plan_length
 from tb3_navigation.scan import Scan
@@ -110,8 +110,9 @@ def house_entry():
 
 def test_frontiers_of_a_partial_map_open_onto_unseen_floor(house_entry):
     """Each candidate's goal is truly free with room for the robot; the unknown cells beside each
-    candidate are mostly truly open floor (a frontier says "more floor beyond"); a plan reaches the
-    best goal, as long as the frontier says."""
+    candidate are mostly truly open floor (a frontier says "more floor beyond"); a plan on navfn's
+    costs reaches the best goal, as long as the frontier says, and move_base's (keeping its
+    obstacle_clearance) reaches it too."""
     drive, grid, values = house_entry
     cut = world_map.in_plane(load_world('turtlebot3_house', str(REPO / 'worlds')).obstacles)
     robot = tuple(drive.truth[-1])
@@ -133,8 +134,10 @@ def test_frontiers_of_a_partial_map_open_onto_unseen_floor(house_entry):
         open_share = np.mean(world_map.signed_distance(cut, centres) > 0)
         assert open_share > 0.8, (frontier.centroid, open_share)
     best = search.best
-    plan = GlobalPlanner().make_plan(Costmap(grid, CostmapConfig(), static=values), robot, best.goal)
+    costmap = Costmap(grid, CostmapConfig(), static=values)
+    plan = GlobalPlanner(NAVFN).make_plan(costmap, robot, best.goal)
     assert plan is not None and plan_length(plan) == pytest.approx(best.distance, rel=0.1)
+    assert GlobalPlanner().make_plan(costmap, robot, best.goal) is not None
 
 
 def test_the_search_on_the_slam_s_20_m_map_costs_what_its_known_part_does(house_entry):

@@ -259,3 +259,22 @@ def test_replans_bounded_by_the_last_plan_are_as_cheap_as_plans_from_scratch(wor
         end = costs.grid.to_cells(np.array([goal[:2]]))[0]
         assert planner.potential[end[1], end[0]] == pytest.approx(fresh.potential[end[1], end[0]], rel=1e-12)
         assert len(replanned) == len(first)
+
+
+def test_plans_keep_obstacle_clearance_past_a_door_where_navfn_s_hug_its_frame():
+    """turtlebot3_house's door between the living room and the hall (x 0.65-1.55 m at y -0.15, a
+    stand 0.4 m south of it): from the north-west corner of the door to a goal south-west of it,
+    navfn's plan passes 0.10 m from the west frame (cells beyond the inscribed radius, 0.051 m to
+    the padded Burger's front edge, are all it refuses); with obstacle_clearance the plan keeps
+    that radius plus 0.12 m, longer by the way round (past the stand's east side)."""
+    obstacles = world_cut('turtlebot3_house')
+    grid, data = world_map.map_of_world(obstacles)
+    costmap = Costmap(grid, CostmapConfig(), static=data)
+    start, goal = (0.47, 0.19, -0.36), (-0.3, -1.2, 0.0)
+    plans = {clearance: check_plan(GlobalPlanner(PlannerConfig(obstacle_clearance=clearance)).make_plan(
+        costmap, start, goal), costmap, start, goal, obstacles) for clearance in (0.0, 0.12)}
+    nearest = {clearance: world_map.signed_distance(obstacles, plan[:, :2]).min() for clearance, plan in plans.items()}
+    print('MEASURED past the house door: navfn %.3f m from the frame, %.2f m long; with the clearance %.3f m, %.2f m'
+          % (nearest[0.0], plan_length(plans[0.0]), nearest[0.12], plan_length(plans[0.12])))
+    assert nearest[0.0] < costmap.inscribed_radius + 0.12 <= nearest[0.12]
+    assert plan_length(plans[0.12]) < 2.0 * plan_length(plans[0.0])

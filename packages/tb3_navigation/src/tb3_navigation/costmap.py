@@ -308,6 +308,14 @@ class Costmap(object):
         cells = cells[self.grid.inside(cells)]
         return np.unique(cells[:, 1] * self.grid.width + cells[:, 0])
 
+    def distance_cost(self, metres):
+        """The inflation cost of a cell whose centre lies `metres` plus half a cell from the nearest
+        obstacle cell's: a cell this dear or dearer is nearer than `metres` to an obstacle."""
+        resolution = self.grid.resolution
+        return float(inflation_costs(np.array([(metres + resolution / 2.0) / resolution]), resolution,
+                                     self.inscribed_radius, self.config.inflation_radius,
+                                     self.config.cost_scaling_factor)[0])
+
     def cost_at(self, xy):
         """Costs at points (..., 2); NO_INFORMATION off the map."""
         cells = self.grid.to_cells(xy)

@@ -24,8 +24,7 @@ import math
 from dataclasses import dataclass
 
 from .costmap import CostmapConfig
-from .frontiers import ExploreConfig, FrontierSearch
-from .planner import PlannerConfig
+from .frontiers import NAVFN, ExploreConfig, FrontierSearch
 
 SEND, KEEP, WAIT, DONE = 'send', 'keep', 'wait', 'done'
 MAP_WAIT = 5.0  # s: the longest wait for a map newer than a goal's success (the SLAM's come every 2 s)
@@ -46,7 +45,7 @@ class Decision:
 class Explorer(object):
     """The exploration's state: the goal pursued, the blacklist, progress, done."""
 
-    def __init__(self, config=ExploreConfig(), costmap_config=CostmapConfig(), planner_config=PlannerConfig()):
+    def __init__(self, config=ExploreConfig(), costmap_config=CostmapConfig(), planner_config=NAVFN):
         self.config = config
         self.frontier_search = FrontierSearch(config, costmap_config, planner_config)
         self.blacklist = []      # [(x, y)]: goals that failed

@@ -167,11 +167,16 @@ def label_frontiers(values):
     return ndimage.label(frontier_cells(values), structure=EIGHT)
 
 
+#: The search's planner: navfn's plain costs. With move_base's obstacle_clearance the cheapest frontier
+#: cell of a partial map was the one reached through a wall not seen yet rather than past a door frame.
+NAVFN = PlannerConfig(obstacle_clearance=0.0)
+
+
 class FrontierSearch(object):
     """Frontiers of an OccupancyGrid's values, weighed by the rule, on a costmap made from that map
     as move_base's global costmap makes it (costmap_config: the robot's footprint and inflation)."""
 
-    def __init__(self, config=ExploreConfig(), costmap_config=CostmapConfig(), planner_config=PlannerConfig()):
+    def __init__(self, config=ExploreConfig(), costmap_config=CostmapConfig(), planner_config=NAVFN):
         self.config = config
         self.costmap_config = costmap_config
         self.planner = GlobalPlanner(planner_config)

@@ -14,6 +14,17 @@ and the walk follows its predecessors, so each step of the plan goes to
 the neighbour the cheapest path came from. Orientations are those of global_planner's orientation
 filter (forward by default): each pose faces the next, the last one is the goal's.
 
+One addition of ours, obstacle_clearance (0.12 m, as the controller's):
+a step into a cell whose centre is nearer than the footprint's inscribed
+radius plus obstacle_clearance to an obstacle costs CLOSE_STEP more, so
+a plan passes a door or a corner that near only where no way round is
+shorter than 1 m a cell. navfn's plans hugged door frames and corners 10-13 cm
+from the Burger's centre (it refuses only cells within the inscribed radius,
+5.1 cm to the padded footprint's front edge), where DWA with
+TurtleBot3's values cannot make the turn (min_vel_theta 1.37 rad/s is out
+of its window from rest) and rocked forward and back until the recoveries
+gave up: see doc/speed.md. 0: navfn's plans.
+
 global_planner/GlobalPlanner is the same search with its own step cost
 (getCost: lethal_cost blocks, steps capped one below it; its defaults
 neutral 50, factor 3.0, lethal 253) and its orientation modes. Its other
@@ -36,6 +47,8 @@ from tb3_navigation.costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION
 from tb3_navigation.grid_graph import UNREACHED, build, neighbours, path_cost, path_to, reweigh, shortest_paths
 
 COST_OBS = 254  # navfn: the step cost of a cell it must not enter (and one below: the dearest it may)
+#: Added to the step into a cell nearer than obstacle_clearance: 20 steps in the open (1 m at 0.05 m cells).
+CLOSE_STEP = 20.0 * 50.0
 #: Costs changed in more than 1 cell of this many: the graphs are built anew (mending a 16th of a
 #: 400 x 260 graph's cells took longer than building it anew, a 32nd two thirds as long).
 MENDED_SHARE = 32
@@ -56,6 +69,9 @@ class PlannerConfig(Checked):
     orientation_mode: int = parameter(1, "global_planner's: the plan's headings: 0 none, 1 forward, 2 interpolate, "
                                          '3 forward then interpolate, 4 backward, 5 leftward, 6 rightward',
                                   number(0, 6))
+    obstacle_clearance: float = parameter(0.12, 'm (ours): plans keep this far from obstacles (beyond the '
+                                                "footprint's inscribed radius) where a way round costs under "
+                                                '1 m a cell; 0: navfn\'s plans', non_negative, 'm')
     orientation_window_size: Optional[int] = parameter(None, "global_planner's: a pose heads from this many poses "
                                                              'before it to as many after it; unset: to the next one',
                                                        number(1))
@@ -72,13 +88,14 @@ class GlobalPlanner(object):
     def __init__(self, config=PlannerConfig()):
         self.config = config
         self.potential = None  # (H, W): the last search's cost from the robot to each cell it reached, else inf
-        self._costs = self._steps = None
+        self._costs = self._steps = self._close = None
         self._graphs = {}  # of the costs, with their heuristic: None: plain; a goal's cell: reweighted toward it (A*)
         self._last = None  # the cells of the last plan that ended at its goal's cell
 
-    def step_costs(self, costs):
+    def step_costs(self, costs, close=None):
         """navfn's setCostmap (global_planner's getCost with a lethal_cost): the cost (float (H, W)) of
-        stepping into each cell, inf if it is blocked."""
+        stepping into each cell, inf if it is blocked; CLOSE_STEP more into a known, unblocked cell
+        costing `close` or more (None: none)."""
         config = self.config
         costs = np.asarray(costs)
         steps = config.neutral_cost + config.cost_factor * costs.astype(float)
@@ -90,10 +107,17 @@ class GlobalPlanner(object):
             steps = np.where(costs < lethal - 1, np.minimum(steps, lethal - 1), lethal)
             blocked = costs >= lethal
             unknown = min(config.neutral_cost + config.cost_factor * NO_INFORMATION, lethal - 1)
+        if close is not None:
+            steps = np.where((costs >= close) & (costs < INSCRIBED_INFLATED_OBSTACLE), steps + CLOSE_STEP, steps)
         if config.allow_unknown:
             steps = np.where(costs == NO_INFORMATION, unknown, steps)
             blocked &= costs != NO_INFORMATION
         return np.where(blocked, np.inf, steps)
+
+    def close_cost(self, costmap):
+        """The cost from which a cell of `costmap` is too close for a plan (None: obstacle_clearance 0)."""
+        clearance = self.config.obstacle_clearance
+        return costmap.distance_cost(costmap.inscribed_radius + clearance) if clearance > 0 else None
 
     def make_plan(self, costmap, start, goal, tolerance=None):
         """The plan [(x, y, yaw), ...] from `start` to `goal` (x, y, yaw, in the
@@ -107,7 +131,7 @@ class GlobalPlanner(object):
         start_cell = grid.to_cells(np.asarray(start[:2], dtype=float))
         if not grid.inside(start_cell):
             return None
-        self._use(costmap.costs)
+        self._use(costmap)
         distances, predecessors = self._search(grid, int(start_cell[1] * grid.width + start_cell[0]), goal, tolerance)
         self.potential = distances
         target = self._target(grid, distances, goal, tolerance)
@@ -135,31 +159,31 @@ class GlobalPlanner(object):
         start_cell = grid.to_cells(np.asarray(start[:2], dtype=float))
         if not grid.inside(start_cell):
             return None
-        self._use(costmap.costs)
+        self._use(costmap)
         distances, predecessors = shortest_paths(self._graph(None), grid.shape,
                                                  [int(start_cell[1] * grid.width + start_cell[0])])
         self.potential = distances
         return distances, predecessors
 
-    def _use(self, costs):
-        """Step costs and graphs of `costs`: kept while they stay the same, mended where a few cells
+    def _use(self, costmap):
+        """Step costs and graphs of `costmap`'s costs: kept while they stay the same, mended where a few cells
         changed (a global costmap's update, nearly every replan while a map grows: 96 % of a turtlebot3_world
         exploration's; the graphs anew took 17 ms of a 28 ms plan across the house)."""
-        costs = np.asarray(costs)
-        if self._costs is not None and self._costs.shape == costs.shape:
+        costs, close = np.asarray(costmap.costs), self.close_cost(costmap)
+        if self._costs is not None and self._costs.shape == costs.shape and close == self._close:
             changed = np.flatnonzero(self._costs != costs)
             if not len(changed):
                 return
             if len(changed) <= costs.size // MENDED_SHARE:
                 self._costs.ravel()[changed] = costs.ravel()[changed]
-                self._steps.ravel()[changed] = self.step_costs(costs.ravel()[changed])
+                self._steps.ravel()[changed] = self.step_costs(costs.ravel()[changed], close)
                 for graph, heuristic in self._graphs.values():
                     reweigh(graph, self._steps, changed, heuristic=heuristic)
                 return
         if self._costs is None or self._costs.shape != costs.shape:
             self._last = None  # its cells are another grid's
-        self._costs = np.array(costs, copy=True)
-        self._steps = self.step_costs(costs)
+        self._costs, self._close = np.array(costs, copy=True), close
+        self._steps = self.step_costs(costs, close)
         self._graphs = {}
 
     def _search(self, grid, start_index, goal, tolerance):

@@ -63,16 +63,6 @@ class TrajectoryScorer(object):
     def __init__(self, costmap, config):
         self.costmap, self.config = costmap, config
 
-    def close_cost(self):
-        """The cost of a cell whose centre is obstacle_clearance plus half a cell from the nearest
-        obstacle cell's: a footprint over such a cell or a dearer one is too close."""
-        from tb3_navigation.costmap import inflation_costs
-        costmap = self.costmap
-        resolution = costmap.grid.resolution
-        cells = (self.config.obstacle_clearance + resolution / 2.0) / resolution
-        return float(inflation_costs(np.array([cells]), resolution, costmap.inscribed_radius,
-                                     costmap.config.inflation_radius, costmap.config.cost_scaling_factor)[0])
-
     def maps(self, pose, local):
         """Cells (as step counts) from the plan, from the local goal and from the local goal
         pushed forward_point_distance along the robot's bearing to it, with the scales."""
@@ -144,7 +134,8 @@ class TrajectoryScorer(object):
         order = np.flatnonzero(~rejected)
         order = order[np.argsort(costs[order], kind='stable')]
         best = math.inf
-        close_cost = self.close_cost() if clearance and config.obstacle_clearance > 0 else 0.0
+        close_cost = self.costmap.distance_cost(config.obstacle_clearance) \
+            if clearance and config.obstacle_clearance > 0 else 0.0
         for start in range(0, len(order), CHUNK):
             chunk = order[start:start + CHUNK]
             if not check_all and costs[chunk[0]] > best:
