@@ -27,7 +27,7 @@ from .wall_shapes import WallShapes
 
 #: Standard deviations (m, m, rad) of a constraint the scans' matches made, between two scans in a row
 #: or closing a loop: 2 cm and 0.6 degree. Where the pose followed the odometry between two scans (no
-#: match, or a snap left out), gmapping's odometry error model adds its own (odometry_sigmas), so that a
+#: match, or a snap left out), gmapping's odometry error model adds its own (information()), so that a
 #: closure's correction goes where the drift came from: on the drive round the outside of the house, 5
 #: of the 58 unmatched steps, turns in the yard, held as much yaw error as the 803 matched ones.
 MATCHED = (0.02, 0.02, 0.01)
@@ -171,16 +171,12 @@ class LoopCloser(object):
             self._draw(grid, index)
 
 
-def odometry_sigmas(config, distance, rotation):
-    """Standard deviations (m, rad) of the odometry's error over `distance` m and `rotation` rad driven, by
-    gmapping's model and parameters: srr and srt (translation per m, per rad), str and stt (rotation)."""
-    return (config.srr * distance + config.srt * rotation, config.str * distance + config.stt * rotation)
-
-
 def information(config, distance=0.0, rotation=0.0):
     """The information matrix of a constraint matched by scans (MATCHED) with `distance` m and `rotation`
-    rad of unmatched odometry in it."""
-    translation, turn = odometry_sigmas(config, distance, rotation)
+    rad of unmatched odometry in it, whose error has gmapping's model and parameters as standard deviations:
+    srr and srt (translation per m, per rad), str and stt (rotation)."""
+    translation = config.srr * distance + config.srt * rotation
+    turn = config.str * distance + config.stt * rotation
     return np.diag(1.0 / (np.square(MATCHED) + np.square((translation, translation, turn))))
 
 
