@@ -2,7 +2,7 @@
 or frame aborted at once), its make_plan and clear_costmaps services and the checks of its parameters,
 with a fake clock, a fake planner and a fake controller (navigator_fakes.py); then the whole stack
 (costmaps, planner, DWA) in turtlebot3_world: a goal inside a pillar, a box in the way; in
-turtlebot3_house, through a door that needs a sharp turn. Planning, the
+turtlebot3_house, through a door that needs a sharp turn, and from where DWA would back away. Planning, the
 recoveries and their timers are test_navigator_recovery.py's (no ROS)."""
 import math
 
@@ -182,4 +182,25 @@ def test_a_goal_through_the_house_door_with_a_sharp_turn_is_reached_without_reco
     assert outcome is not None and outcome.status == SUCCEEDED
     assert math.hypot(robot.pose[0] - goal[0], robot.pose[1] - goal[1]) <= 0.05
     assert not any(step.recovery for step in steps)
+    assert clearance['all'] >= 0.09
+
+
+@pytest.mark.parametrize('heading', [3.0, 3.3])
+def test_where_dwa_would_back_away_from_the_plan_the_robot_turns_to_face_it(heading):
+    """From the hall's east side, facing about west, to a goal beyond the door north of it: DWA turned
+    north early, east of the door and facing the wall 0.3 m ahead, where every forward arc comes too near
+    and no turn in place is within its window; it backed and drove forward in turn until the recoveries
+    ABORTED the goal (68-78 s, headings 3.0-3.3 rad). Turning to face the plan instead of backing, the
+    goal is reached (46-95 s there, at most the four recoveries on the way)."""
+    obstacles = world_cut('turtlebot3_house')
+    start, goal = (2.37, -0.77, heading), (6.54, 1.83, 0.0)
+    navigator, global_costmap, local_costmap = stack(obstacles, start)
+    robot = Unicycle(start)
+    navigator.set_goal(0.0, goal, quaternion_of_yaw(goal[2]))
+    outcome, steps, clearance = run_stack(navigator, global_costmap, local_costmap, robot, Lidar(obstacles), 120.0)
+    print('MEASURED from the hall\'s east side: %s after %.1f s, recoveries %s, footprint at least %.3f m from the '
+          'walls' % (outcome and outcome.text, len(steps) * PERIOD, [s.recovery for s in steps if s.recovery],
+                     clearance['all']))
+    assert outcome is not None and outcome.status == SUCCEEDED
+    assert math.hypot(robot.pose[0] - goal[0], robot.pose[1] - goal[1]) <= 0.05
     assert clearance['all'] >= 0.09

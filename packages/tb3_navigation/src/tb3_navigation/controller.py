@@ -12,6 +12,9 @@ oscillation_reset_dist or oscillation_reset_angle). Each is scored by DWA's
 critics (tb3_navigation.trajectory_scoring); the cheapest wins (the first
 sampled among equals); none: the robot is told to stop and the call fails.
 
+Where DWA's choice would back away from a plan that lies ahead (ours, see
+_face_the_plan), the robot stops and turns in place to face the plan instead.
+
 Within xy_goal_tolerance of the goal (latched if latch_xy_goal_tolerance)
 the stop-and-rotate controller takes over: slow down with the accelerations
 until stopped (trans_stopped_vel, theta_stopped_vel 0.1), then turn in place
@@ -163,6 +166,8 @@ class DwaController(object):
                 command = self._last_centimetres(pose, velocity, maps, plan[-1])
             if command is None:
                 command = self._dwa(pose, velocity, maps, plan[-1])
+                if command.ok and command.v < 0:
+                    command = self._face_the_plan(pose, velocity, maps, local) or command
         return replace(self._safe(command), followed=local)
 
     def _local_plan(self, pose, plan):
@@ -243,6 +248,27 @@ class DwaController(object):
             speed = min(config.min_vel_trans, distance * math.cos(error) / period)
             v = min(max(-speed if backwards else speed, velocity[0] - reach), velocity[0] + reach)
             w = self._braking(velocity)[1]
+        return self._checked(pose, maps, v, w)
+
+    def _face_the_plan(self, pose, velocity, maps, local):
+        """Instead of DWA's backing: stop, then turn in place to face the first point of the local plan
+        forward_point_distance or more away; None (DWA's command then) if there is none, the robot faces
+        it within FACING, or the turn would meet an obstacle. Where every forward arc of DWA's window
+        comes nearer than obstacle_clearance or meets an obstacle (a door frame, a corner turned early),
+        DWA backs away; with no turn in place within its window from rest (min_vel_theta 1.37 rad/s,
+        acc_lim_theta 3.2 over 0.1 s) it drove forward again, one period each way (the oscillation flags
+        go with every new plan, five times a second), until move_base's recoveries gave up.
+        tools/bench_house_tour.py, five tours of 12 goals: 58 -> 60 reached, standing still 280 -> 137 s."""
+        config = self.config
+        ahead = np.flatnonzero(np.hypot(local[:, 0] - pose[0], local[:, 1] - pose[1]) >= config.forward_point_distance)
+        if not len(ahead):
+            return None
+        target = local[ahead[0]]
+        error = normalize_angle(math.atan2(target[1] - pose[1], target[0] - pose[0]) - pose[2])
+        if abs(error) <= FACING:
+            return None
+        stopped = abs(velocity[0]) <= config.trans_stopped_vel
+        v, w = (0.0, self._turning(error, velocity)) if stopped else self._braking(velocity)
         return self._checked(pose, maps, v, w)
 
     def _dwa(self, pose, velocity, maps, goal):
