@@ -19,6 +19,7 @@ import time
 import numpy as np
 
 from tb3_common.pose2d import quaternion_of_yaw
+from tb3_harness.exploring import stood_still
 from tb3_harness.measure import machine
 from tb3_harness.nav_sim import PERIOD, Lidar, Unicycle, run_stack, stack, world_cut
 from tb3_navigation.navigator import SUCCEEDED
@@ -44,16 +45,10 @@ def goals(obstacles, costmap, seed, count, clearance=0.2):
 
 
 def standing_still(poses):
-    """Seconds of the stretches in which the robot stayed within STILL_RADIUS for STILL_SECONDS or more."""
-    poses, total, first = np.asarray(poses)[:, :2], 0.0, 0
-    while first < len(poses):
-        last = first
-        while last + 1 < len(poses) and np.hypot(*(poses[last + 1] - poses[first])) < STILL_RADIUS:
-            last += 1
-        if (last - first) * PERIOD >= STILL_SECONDS:
-            total += (last - first) * PERIOD
-        first = last + 1
-    return total
+    """Seconds of the stretches in which the robot stayed within STILL_RADIUS for STILL_SECONDS or more
+    (exploring.stood_still of the poses, one a period)."""
+    path = [(index * PERIOD, pose[0], pose[1]) for index, pose in enumerate(poses)]
+    return sum(seconds for _, seconds, _ in stood_still(path, STILL_RADIUS, STILL_SECONDS))
 
 
 def tour(obstacles, seed, count, planner_config):
