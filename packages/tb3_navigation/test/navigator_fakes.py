@@ -1,17 +1,17 @@
 """The navigator's tests' stand-ins (no ROS): a fake planner, controller and costmap that do as they are
-set to and count their calls, and Run, the navigator stepped at 10 Hz (PERIOD) with them and a robot that
-turns (and drives, if moving) as told; UP, the goal orientation of yaw 0.
+set to and count their calls, and Run, the navigator stepped at 10 Hz (nav_sim.PERIOD, move_base's
+controller_frequency) with them and a robot that turns (and drives, if moving) as told; UP, the goal
+orientation of yaw 0.
 """
 import math
 
 import numpy as np
 
 from tb3_common.pose2d import quaternion_of_yaw
-from tb3_harness.nav_sim import MAP_IN_ODOM
+from tb3_harness.nav_sim import MAP_IN_ODOM, PERIOD
 from tb3_navigation.controller import Command
 from tb3_navigation.navigator import Navigator, NavigatorConfig
 
-PERIOD = 0.1
 UP = quaternion_of_yaw(0.0)
 
 

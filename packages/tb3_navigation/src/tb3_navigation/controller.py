@@ -211,6 +211,13 @@ class DwaController(object):
         reach = config.acc_lim_theta * period
         return min(max(math.copysign(speed, difference), velocity[1] - reach), velocity[1] + reach)
 
+    def _turn_in_place(self, error, velocity):
+        """(v, w) towards a heading `error` rad away: braking until stopped (trans_stopped_vel), then
+        turning in place."""
+        if abs(velocity[0]) <= self.config.trans_stopped_vel:
+            return 0.0, self._turning(error, velocity)
+        return self._braking(velocity)
+
     def _checked(self, pose, maps, v, w):
         """The Command (v, w) with its trajectory, or None if its footprint would meet an obstacle
         (`maps`: the scorer's maps for this pose and local plan)."""
@@ -241,8 +248,7 @@ class DwaController(object):
         backwards = abs(bearing) > math.pi / 2 and config.min_vel_x < 0.0
         error = normalize_angle(bearing - math.pi) if backwards else bearing
         if abs(error) > FACING:
-            stopped = abs(velocity[0]) <= config.trans_stopped_vel
-            v, w = (0.0, self._turning(error, velocity)) if stopped else self._braking(velocity)
+            v, w = self._turn_in_place(error, velocity)
         else:
             reach = config.acc_lim_x * period
             speed = min(config.min_vel_trans, distance * math.cos(error) / period)
@@ -267,9 +273,7 @@ class DwaController(object):
         error = normalize_angle(math.atan2(target[1] - pose[1], target[0] - pose[0]) - pose[2])
         if abs(error) <= FACING:
             return None
-        stopped = abs(velocity[0]) <= config.trans_stopped_vel
-        v, w = (0.0, self._turning(error, velocity)) if stopped else self._braking(velocity)
-        return self._checked(pose, maps, v, w)
+        return self._checked(pose, maps, *self._turn_in_place(error, velocity))
 
     def _dwa(self, pose, velocity, maps, goal):
         config = self.config
