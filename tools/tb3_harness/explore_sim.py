@@ -28,7 +28,7 @@ SPEED = 0.22     # m/s: the Burger's top speed, for the sim time of a step
 STEP = 0.1       # m between two scans
 MAX_URANGE = 3.0  # turtlebot3_slam's maxUrange
 PLANNER_PATIENCE = 5.0  # s: TurtleBot3's move_base gives up on a goal it finds no plan to for this long
-DRIVE_PADDING = 0.11  # m: the Burger's inscribed radius becomes 0.151 m, under the explorer's 0.163 for goals
+DRIVE_PADDING = 0.11  # m: the Burger's inscribed radius becomes 0.151 m, under the explorer's 0.213 for goals
 
 
 class ExploreLoop(object):

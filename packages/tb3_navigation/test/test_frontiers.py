@@ -155,8 +155,8 @@ def test_a_frontier_no_plan_reaches_is_not_chosen():
 
 def test_a_frontier_where_the_robot_does_not_fit_and_a_small_one_are_not_chosen():
     """North of a closed room, a strip of floor 0.15 m wide along its wall, seen (through a window)
-    with unknown space all round: no cell of it is 0.163 m (the Burger's circumscribed radius)
-    from the wall. In the room, an unknown patch of 1 x 3 cells: a frontier of 8 cells, 0.4 m."""
+    with unknown space all round: no cell of it is 0.213 m (a cell beyond the Burger's circumscribed
+    radius) from the wall. In the room, an unknown patch of 1 x 3 cells: a frontier of 8 cells, 0.4 m."""
     values = np.full((30, 60), -1, dtype=np.int8)
     values[0:21, 0:60] = 100
     values[1:20, 1:59] = 0
@@ -170,6 +170,21 @@ def test_a_frontier_where_the_robot_does_not_fit_and_a_small_one_are_not_chosen(
     assert 'boxed in' not in search.why_none()
     smaller = FrontierSearch(ExploreConfig(min_frontier_size=0.4)).search(grid, values, (0.5, 0.5, 0.0))
     assert smaller.best is not None and smaller.best.size == pytest.approx(0.4)
+
+
+def test_a_goal_leaves_a_cell_to_spare_beyond_the_circumscribed_radius():
+    """The robot on a strip of floor 0.20 m wide along a wall, unknown beyond: the strip's outer cells'
+    centres lie 0.20 m from the wall's, beyond the circumscribed radius (0.163 m) but within a cell of
+    it. Move_base's costmap draws a wall a cell nearer as often as not, and a robot sent there could not
+    turn (frontiers.TURN_MARGIN): no room. On a strip 0.25 m wide the outer edge has room."""
+    grid = Grid(RESOLUTION, 60, 30)
+    for rows, status in ((4, NO_ROOM), (5, CANDIDATE)):
+        values = np.full((30, 60), -1, dtype=np.int8)
+        values[10, :] = 100
+        values[11:11 + rows, 5:55] = 0
+        robot = (30.5 * RESOLUTION, (11 + rows - 0.5) * RESOLUTION, 0.0)
+        statuses = [frontier.status for frontier in FrontierSearch().search(grid, values, robot).frontiers]
+        assert statuses == [status], (rows, statuses)
 
 
 def test_a_frontier_far_from_every_wall_is_in_the_open():

@@ -11,8 +11,8 @@ frontier.
 Each frontier has its size (cells x resolution, m, as explore_lite counts
 it), centroid and goal. The goal is the frontier's cell that the global
 planner reaches most cheaply, among those where the footprint fits
-whichever way the robot turns (cost at most the circumscribed radius's: 180
-for the Burger, 0.163 m from a wall) and outside the blacklist: explore_lite's
+whichever way the robot turns, with a cell to spare (TURN_MARGIN: cost at most
+that 0.213 m from a wall has for the Burger) and outside the blacklist: explore_lite's
 "middle" (the nearest point), but nearest along the plan, not in a straight
 line. Not its centroid (explore_lite's goal since 2.1): the centroid of a
 curved frontier, or of one wrapped round a corner, lies in unknown space or
@@ -167,6 +167,12 @@ def label_frontiers(values):
     return ndimage.label(frontier_cells(values), structure=EIGHT)
 
 
+#: Cells a goal lies farther from the walls than the circumscribed radius. Move_base's costmap, made
+#: from the live scans, draws a wall a cell nearer than the map the goal was chosen on as often as not
+#: (a wall's face on a cell's edge), and a robot at a goal it cannot turn at stays there: DWA with
+#: TurtleBot3's values cannot start a turn in place, and rotate_recovery checks the turn on the costmap.
+#: (turtlebot3_house, 2026-11-29: a goal 0.17 m from a wall's face, the robot stuck there for 560 s.)
+TURN_MARGIN = 1
 #: The search's planner: navfn's plain costs. With move_base's obstacle_clearance the cheapest frontier
 #: cell of a partial map was the one reached through a wall not seen yet rather than past a door frame.
 NAVFN = PlannerConfig(obstacle_clearance=0.0)
@@ -183,9 +189,9 @@ class FrontierSearch(object):
         self.costmap = None  # the last search's
 
     def admissible_cost(self, costmap):
-        """The highest cost where the footprint fits whichever way the robot turns: the cost at
-        the circumscribed radius (costmap_2d's circumscribed cost)."""
-        at = np.array(costmap.circumscribed_radius / costmap.grid.resolution)
+        """The highest cost where the footprint fits whichever way the robot turns, with a cell to
+        spare: the cost a cell beyond the circumscribed radius (costmap_2d's circumscribed cost's)."""
+        at = np.array(costmap.circumscribed_radius / costmap.grid.resolution + TURN_MARGIN)
         cost = inflation_costs(at, costmap.grid.resolution, costmap.inscribed_radius,
                                self.costmap_config.inflation_radius, self.costmap_config.cost_scaling_factor)
         return min(int(cost), INSCRIBED_INFLATED_OBSTACLE - 1)
