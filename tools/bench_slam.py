@@ -20,7 +20,15 @@ import numpy as np
 
 from tb3_common.pose2d import normalize_angle
 from tb3_harness import ROOT
-from tb3_harness.drives import HOUSE_TOUR, HOUSE_TOUR_START, WORLD_LOOP, WORLD_LOOP_START, path_length, record_drive
+from tb3_harness.drives import (
+    HOUSE_OUTSIDE,
+    HOUSE_TOUR,
+    HOUSE_TOUR_START,
+    WORLD_LOOP,
+    WORLD_LOOP_START,
+    path_length,
+    record_drive,
+)
 from tb3_harness.map_quality import QualityConfig
 from tb3_harness.map_quality import measure as map_quality
 from tb3_navigation.scan import Scan
@@ -33,12 +41,6 @@ HOUSE_ROUND = [(-1.0, 1.2), (-1.0, 4.0), (-4.0, 4.0), (-4.4, 3.3), (-6.3, 3.3), 
                (1.2, 0.4), (3.0, 0.4), (3.0, 1.2), (3.0, 4.6), (1.0, 4.6), (1.0, 1.6), (1.0, 4.6), (3.0, 4.6),
                (6.5, 4.0), (6.8, 1.0), (6.2, 0.5), (6.2, -1.0), (5.6, -1.5), (5.6, -4.5), (6.8, -4.5), (6.8, -1.0),
                (6.2, -0.6), (6.2, 0.5), (3.0, 0.4), (-1.0, 0.4), (-3.0, 1.0)]
-
-#: Out of the house through the yard, round the outside of the house and back in: the SLAM drifts 41 cm on
-#: the north and east sides, where no wall it saw before is in range.
-HOUSE_OUTSIDE = [(-1.0, 0.4), (1.2, 0.4), (1.2, -1.4), (-2.5, -4.5), (-4.5, -5.6), (-8.3, -4.8), (-8.6, 6.0),
-                 (-7.5, 6.5), (7.5, 6.5), (8.7, 5.5), (8.7, -6.0), (7.5, -6.8), (5.0, -6.8), (3.5, -5.0), (2.5, -2.0),
-                 (1.2, -1.4), (1.2, 0.4), (-1.0, 0.4), (-3.0, 1.0), (-4.4, 3.3), (-1.0, 4.0), (-1.0, 1.2), (-3.0, 1.0)]
 
 DRIVES = {
     'loop': ('turtlebot3_world', WORLD_LOOP_START, WORLD_LOOP),

@@ -25,6 +25,7 @@ from tb3_sim_nav.world_file import load_world
 
 from . import ROOT as REPO
 from .waypoints import (  # noqa: F401
+    HOUSE_OUTSIDE,
     HOUSE_TOUR,
     HOUSE_TOUR_START,
     WORLD_GOALS,

@@ -8,10 +8,11 @@ drifted; when old walls come back in range, the pose snaps back onto them over a
 keeps the drifted walls, a second time (doc/design.md).
 
 So the chain of the graph does not take the SLAM's step between two scans when it snapped (differs by
-more than SNAP from the odometry's step, which knows no walls): it takes the odometry's. The chain
-then still holds the drift, and a closure, which says where the robot really came back, disagrees
-with it: the graph spreads the correction over the poses since the loop began, and the map is drawn
-anew from every scan at its corrected pose.
+more than SNAP from the odometry's step, which knows no walls), nor when it relocated after a failed
+match: it takes the step matched against the scans added just before (Karto's running scans), or else
+the odometry's. The chain then still holds the drift, and a closure, which says where the robot really
+came back, disagrees with it: the graph spreads the correction over the poses since the loop began,
+and the map is drawn anew from every scan at its corrected pose.
 """
 import math
 from collections import namedtuple
@@ -47,6 +48,10 @@ LEFT_AND_BACK = 2.0
 #: driving apart (a robot standing still adds the same scan again and again).
 SUBMAP_SCANS = 15
 SPACING = 0.2
+#: A scan added after a snap, a relocation or a jump of the odometry is chained by a match against this many
+#: scans added before it (Karto's running scans), where RUNNING_SHARE of its points land on their walls.
+RUNNING_SCANS = 10
+RUNNING_SHARE = 0.75
 #: A closing match this near the pose (m, rad) agrees with it; a graph whose constraints all hold this
 #: well is not worth optimising and redrawing the map for.
 NEGLIGIBLE = (0.025, 0.01)
@@ -86,18 +91,21 @@ class LoopCloser(object):
         c = self.config
         previous = self.graph.poses[index - 1]
         front = relative(previous, pose)
-        # The odometry's step when the SLAM's differs from it by more than SNAP: a snap back onto old walls.
-        step = front if jumped else relative(self._nodes[index - 1].odom, node.odom)
-        snapped = _differ(front, step, SNAP)
+        odometry = relative(self._nodes[index - 1].odom, node.odom)
+        # The SLAM's step differs from the odometry's by more than SNAP: a snap back onto old walls.
+        snapped = not jumped and _differ(front, odometry, SNAP)
         self._travelled.append(self._travelled[-1] + math.hypot(pose[0] - previous[0], pose[1] - previous[1]))
         due = snapped or self._travelled[-1] - self._searched_at >= SEARCH_EVERY
         closure = self._match_old(index, points, walls) if c.do_loop_closing and search and due else None
         if due and not snapped:
             self._searched_at = self._travelled[-1]
-        # A snap back onto old walls stays out of the chain: closures say where the robot came back.
-        if snapped:
-            followed = (math.hypot(step[0], step[1]), abs(step[2]))
-        self.graph.add_edge(index - 1, index, step if snapped else front, information(self.config, *followed))
+        # A snap back onto old walls, or a relocation, stays out of the chain: closures say where the robot
+        # came back. The step is measured on the scans added just before, or else taken from the odometry
+        # (after a snap) or the SLAM (after a jump: the odometry's step is no measure then).
+        step = self._running_step(index, points, odometry) if snapped or jumped else front
+        if step is None and snapped:
+            step, followed = odometry, (math.hypot(odometry[0], odometry[1]), abs(odometry[2]))
+        self.graph.add_edge(index - 1, index, front if step is None else step, information(self.config, *followed))
         if closure is None:
             return None
         old, matched = closure
@@ -117,6 +125,24 @@ class LoopCloser(object):
             self._draw(submap, i)
         field = matcher.WallField(WallShapes.of_map(submap.grid, *submap.walls(c.occ_thresh)), c.sigma)
         return None if field.empty else field
+
+    def _running_step(self, index, points, odometry):
+        """The step from scan `index` - 1 to scan `index` (`points`: its end points, base frame) matched
+        against the RUNNING_SCANS scans added before it, at their poses in the graph, searched around
+        the `odometry`'s step as the SLAM's own match searches (Karto's running scans); None where
+        less than RUNNING_SHARE of the points land on their walls (the scans before saw nothing, or
+        the odometry's step is no measure: the wheels turned on a robot held still, a reset)."""
+        c = self.config
+        previous = self.graph.poses[index - 1]
+        prior = tuple(compose(previous, odometry))
+        field = self._field_of(range(max(0, index - RUNNING_SCANS), index), prior, c.search_linear)
+        if field is None:
+            return None
+        start, _ = matcher.search(field, points, prior, c.search_linear, c.search_angular, c.lstep, c.astep)
+        matched, score = matcher.refine(field, points, start, c.iterations)
+        if score < RUNNING_SHARE * len(points):
+            return None
+        return relative(previous, matched)
 
     def _old_scans_near(self, index, walls):
         """Indices of the old scans (see LEFT_AND_BACK) within loop_search_maximum_distance of scan
