@@ -204,3 +204,22 @@ def test_where_dwa_would_back_away_from_the_plan_the_robot_turns_to_face_it(head
     assert outcome is not None and outcome.status == SUCCEEDED
     assert math.hypot(robot.pose[0] - goal[0], robot.pose[1] - goal[1]) <= 0.05
     assert clearance['all'] >= 0.09
+
+
+def test_from_a_corner_where_dwa_finds_nothing_the_robot_turns_its_way_out():
+    """South of the hall, between the end of the wall west of the door and the mailbox post, facing the
+    wall: where the robot turned at an exploration's goal (2026-11-29). Every arc of DWA's window meets the
+    wall or the post within sim_time, and no turn in place is within the window from rest: move_base ABORTED
+    every goal from there after its four recoveries (31 goals of one exploration). The turn to face the
+    plan, tried now also where DWA finds nothing, leaves the corner within a second."""
+    obstacles = world_cut('turtlebot3_house')
+    start, goal = (0.6012, -0.4201, 2.8485), (-1.37, -2.57, 0.0)
+    navigator, global_costmap, local_costmap = stack(obstacles, start)
+    robot = Unicycle(start)
+    navigator.set_goal(0.0, goal, quaternion_of_yaw(goal[2]))
+    outcome, steps, _ = run_stack(navigator, global_costmap, local_costmap, robot, Lidar(obstacles), 60.0)
+    print('MEASURED from the corner: %s after %.1f s, recoveries %s' % (
+        outcome and outcome.text, len(steps) * PERIOD, [s.recovery for s in steps if s.recovery]))
+    assert outcome is not None and outcome.status == SUCCEEDED
+    assert not [step.recovery for step in steps if step.recovery]
+    assert math.hypot(robot.pose[0] - goal[0], robot.pose[1] - goal[1]) <= 0.05

@@ -12,8 +12,9 @@ oscillation_reset_dist or oscillation_reset_angle). Each is scored by DWA's
 critics (tb3_navigation.trajectory_scoring); the cheapest wins (the first
 sampled among equals); none: the robot is told to stop and the call fails.
 
-Where DWA's choice would back away from a plan that lies ahead (ours, see
-_face_the_plan), the robot stops and turns in place to face the plan instead.
+Where DWA's choice would back away from a plan that lies ahead, or DWA finds
+nothing (ours, see _face_the_plan), the robot stops and turns in place to face
+the plan instead.
 
 Within xy_goal_tolerance of the goal (latched if latch_xy_goal_tolerance)
 the stop-and-rotate controller takes over: slow down with the accelerations
@@ -166,7 +167,7 @@ class DwaController(object):
                 command = self._last_centimetres(pose, velocity, maps, plan[-1])
             if command is None:
                 command = self._dwa(pose, velocity, maps, plan[-1])
-                if command.ok and command.v < 0:
+                if not command.ok or command.v < 0:
                     command = self._face_the_plan(pose, velocity, maps, local) or command
         return replace(self._safe(command), followed=local)
 
@@ -257,14 +258,16 @@ class DwaController(object):
         return self._checked(pose, maps, v, w)
 
     def _face_the_plan(self, pose, velocity, maps, local):
-        """Instead of DWA's backing: stop, then turn in place to face the first point of the local plan
-        forward_point_distance or more away; None (DWA's command then) if there is none, the robot faces
-        it within FACING, or the turn would meet an obstacle. Where every forward arc of DWA's window
-        comes nearer than obstacle_clearance or meets an obstacle (a door frame, a corner turned early),
-        DWA backs away; with no turn in place within its window from rest (min_vel_theta 1.37 rad/s,
-        acc_lim_theta 3.2 over 0.1 s) it drove forward again, one period each way (the oscillation flags
-        go with every new plan, five times a second), until move_base's recoveries gave up.
-        tools/bench_house_tour.py, five tours of 12 goals: 58 -> 60 reached, standing still 280 -> 137 s."""
+        """Instead of DWA's backing, or where DWA finds nothing: stop, then turn in place to face the first
+        point of the local plan forward_point_distance or more away; None (DWA's command then) if there is
+        none, the robot faces it within FACING, or the turn would meet an obstacle. Where every forward arc
+        of DWA's window comes nearer than obstacle_clearance or meets an obstacle (a door frame, a corner
+        turned early), DWA backs away; with no turn in place within its window from rest (min_vel_theta
+        1.37 rad/s, acc_lim_theta 3.2 over 0.1 s) it drove forward again, one period each way (the
+        oscillation flags go with every new plan, five times a second), until move_base's recoveries gave
+        up. tools/bench_house_tour.py, five tours of 12 goals: 58 -> 60 reached, standing still 280 -> 137 s.
+        Where DWA found nothing at all, the robot once stood for the rest of an exploration: turned at a goal
+        into a corner of turtlebot3_house, facing the wall, every arc met the wall or a post behind it."""
         config = self.config
         ahead = np.flatnonzero(np.hypot(local[:, 0] - pose[0], local[:, 1] - pose[1]) >= config.forward_point_distance)
         if not len(ahead):
