@@ -171,7 +171,8 @@ def label_frontiers(values):
 #: from the live scans, draws a wall a cell nearer than the map the goal was chosen on as often as not
 #: (a wall's face on a cell's edge), and a robot at a goal it cannot turn at stays there: DWA with
 #: TurtleBot3's values cannot start a turn in place, and rotate_recovery checks the turn on the costmap.
-#: (turtlebot3_house, 2026-11-29: a goal 0.17 m from a wall's face, the robot stuck there for 560 s.)
+#: (In turtlebot3_house goals 0.17 m from a wall's face left the robot in a corner for good; the margin
+#: alone did not keep it out where the map had only the wall's near face: see controller._face_the_plan.)
 TURN_MARGIN = 1
 #: The search's planner: navfn's plain costs. With move_base's obstacle_clearance the cheapest frontier
 #: cell of a partial map was the one reached through a wall not seen yet rather than past a door frame.
