@@ -55,7 +55,7 @@ def explore_rows(explored, navigated):
     navigated on the first map (what `make demo DEMO_ARGS=--explore` does)."""
     lines = ['turtlebot3_house explored (tb3_slam.launch explore:=true, profile realistic), factor 0, one run each:']
     for label, run in explored.items():
-        quality, still = run.quality, exploring.stood_still(run.truth)
+        quality, still = run.quality, run.still_spells()
         lines += ['  %s:' % label,
                   '%-58s %12s' % ('    goals sent, blacklisted', '%d, %d' % (run.goals, run.blacklisted)),
                   '%-58s %5.0f s / %.0f s' % ('    sim / wall time (the launches included)', run.sim_seconds,

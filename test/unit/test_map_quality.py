@@ -9,7 +9,7 @@ from scipy import ndimage
 
 from tb3_common.grid import Grid
 from tb3_common.map_files import load_map
-from tb3_harness.exploring import stood_still
+from tb3_harness.exploring import ExplorationRun, stood_still
 from tb3_harness.map_quality import QualityConfig, measure, render_png
 from tb3_navigation.raytrace import crossed_cells, end_cells
 from tb3_navigation.scan import Scan
@@ -215,3 +215,12 @@ def test_stood_still_finds_the_spells_a_path_stayed_put_and_only_those():
     assert len(spells) == 1
     start, seconds, where = spells[0]
     assert 9 <= start <= 10 and 30 <= seconds <= 32 and abs(where[0] - 1.0) < 0.11, spells
+
+
+def test_an_exploration_stands_still_only_until_it_is_done():
+    # 30 s driving, the explorer done at 30 s, then 40 s standing while the map is saved and the launches stop.
+    path = [[t, 0.1 * t, 0.0, 0.0] for t in range(31)] + [[30 + t, 3.0, 0.0, 0.0] for t in range(1, 41)]
+    run = ExplorationRun('turtlebot3_world', 0.0, 'no frontier left', 9, 0, 30.0, 12.0, path, 'map.yaml', None,
+                         0.1, {}, done_at=30.0)
+    assert run.still_spells() == []
+    assert len(stood_still(path)) == 1  # the whole recording has the stand after the end
