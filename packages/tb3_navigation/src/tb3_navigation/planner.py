@@ -9,7 +9,7 @@ allow_unknown; spreads a potential from the robot's cell (whose own cost
 never counts: navfn clears it, the robot stands there); and walks down the
 potential from the goal. Here the potential is an exact shortest-path cost
 over the 8 neighbours of each cell (no diagonal step between two blocked
-cells), found by scipy's Dijkstra at C speed (tb3_navigation.grid_graph),
+cells), found by a compiled Dijkstra (tb3_navigation.grid_graph),
 and the walk follows its predecessors, so each step of the plan goes to
 the neighbour the cheapest path came from. Orientations are those of global_planner's orientation
 filter (forward by default): each pose faces the next, the last one is the goal's.
@@ -44,14 +44,11 @@ import numpy as np
 from tb3_common.params import Checked, fail, non_negative, number, parameter
 from tb3_common.pose2d import normalize_angle
 from tb3_navigation.costmap import INSCRIBED_INFLATED_OBSTACLE, NO_INFORMATION
-from tb3_navigation.grid_graph import UNREACHED, build, neighbours, path_cost, path_to, reweigh, shortest_paths
+from tb3_navigation.grid_graph import UNREACHED, GridGraph, neighbours, path_cost, path_to, shortest_paths
 
 COST_OBS = 254  # navfn: the step cost of a cell it must not enter (and one below: the dearest it may)
 #: Added to the step into a cell nearer than obstacle_clearance: 20 steps in the open (1 m at 0.05 m cells).
 CLOSE_STEP = 20.0 * 50.0
-#: Costs changed in more than 1 cell of this many: the graphs are built anew (mending a 16th of a
-#: 400 x 260 graph's cells took longer than building it anew, a 32nd two thirds as long).
-MENDED_SHARE = 32
 
 
 @dataclass(frozen=True)
@@ -89,7 +86,7 @@ class GlobalPlanner(object):
         self.config = config
         self.potential = None  # (H, W): the last search's cost from the robot to each cell it reached, else inf
         self._costs = self._steps = self._close = None
-        self._graphs = {}  # of the costs, with their heuristic: None: plain; a goal's cell: reweighted toward it (A*)
+        self._graphs = {}  # GridGraphs of the step costs: None: plain; a goal's cell: reweighted toward it (A*)
         self._last = None  # the cells of the last plan that ended at its goal's cell
 
     def step_costs(self, costs, close=None):
@@ -160,26 +157,19 @@ class GlobalPlanner(object):
         if not grid.inside(start_cell):
             return None
         self._use(costmap)
-        distances, predecessors = shortest_paths(self._graph(None), grid.shape,
-                                                 [int(start_cell[1] * grid.width + start_cell[0])])
+        distances, predecessors = shortest_paths(self._graph(None), [int(start_cell[1] * grid.width + start_cell[0])])
         self.potential = distances
         return distances, predecessors
 
     def _use(self, costmap):
-        """Step costs and graphs of `costmap`'s costs: kept while they stay the same, mended where a few cells
-        changed (a global costmap's update, nearly every replan while a map grows: 96 % of a turtlebot3_world
-        exploration's; the graphs anew took 17 ms of a 28 ms plan across the house)."""
+        """Step costs of `costmap`'s costs, which the graphs read: mended where cells changed (a global
+        costmap's update changes a few hundred, nearly every replan while a map grows)."""
         costs, close = np.asarray(costmap.costs), self.close_cost(costmap)
         if self._costs is not None and self._costs.shape == costs.shape and close == self._close:
             changed = np.flatnonzero(self._costs != costs)
-            if not len(changed):
-                return
-            if len(changed) <= costs.size // MENDED_SHARE:
-                self._costs.ravel()[changed] = costs.ravel()[changed]
-                self._steps.ravel()[changed] = self.step_costs(costs.ravel()[changed], close)
-                for graph, heuristic in self._graphs.values():
-                    reweigh(graph, self._steps, changed, heuristic=heuristic)
-                return
+            self._costs.ravel()[changed] = costs.ravel()[changed]
+            self._steps.ravel()[changed] = self.step_costs(costs.ravel()[changed], close)
+            return
         if self._costs is None or self._costs.shape != costs.shape:
             self._last = None  # its cells are another grid's
         self._costs, self._close = np.array(costs, copy=True), close
@@ -195,7 +185,7 @@ class GlobalPlanner(object):
         turtlebot3_house's 400 x 260 cells, a third of them at first)."""
         goal_cell = grid.to_cells(np.asarray(goal[:2], dtype=float))
         if tolerance > 0 or not grid.inside(goal_cell):
-            return shortest_paths(self._graph(None), grid.shape, [start_index])
+            return shortest_paths(self._graph(None), [start_index])
         goal_index = int(goal_cell[1] * grid.width + goal_cell[0])
         if not np.isfinite(self._steps.ravel()[goal_index]) and goal_index != start_index:
             return np.full(grid.shape, np.inf), np.full(grid.shape, UNREACHED)  # a blocked goal
@@ -206,12 +196,13 @@ class GlobalPlanner(object):
             dx, dy = np.abs(ix - goal_cell[0]), np.abs(iy - goal_cell[1])
             self._graph(goal_index, self.config.neutral_cost * (np.maximum(dx, dy)
                                                                 + (math.sqrt(2) - 1) * np.minimum(dx, dy)))
-        graph, heuristic = self._graphs[goal_index]
+        graph = self._graphs[goal_index]
+        heuristic = graph.heuristic
         ahead = heuristic.ravel()[start_index]
         estimate = ahead + self.config.neutral_cost / grid.resolution
         known = self._known_limit(graph, start_index, goal_index)
         for limit in ([] if known is None else [known]) + [2.0 * estimate - ahead, 4.0 * estimate - ahead, np.inf]:
-            distances, predecessors = shortest_paths(graph, grid.shape, [start_index], limit=limit)
+            distances, predecessors = shortest_paths(graph, [start_index], limit=limit)
             if np.isfinite(distances.ravel()[goal_index]):
                 break
         return distances + ahead - heuristic, predecessors
@@ -242,8 +233,8 @@ class GlobalPlanner(object):
         """The graph of the step costs, kept under `key` (None: plain; a goal's cell: A*'s toward it,
         reweighted by `heuristic`)."""
         if key not in self._graphs:
-            self._graphs[key] = (build(self._steps, heuristic=heuristic), heuristic)
-        return self._graphs[key][0]
+            self._graphs[key] = GridGraph(self._steps, heuristic=heuristic)
+        return self._graphs[key]
 
     @staticmethod
     def _target(grid, distances, goal, tolerance):
