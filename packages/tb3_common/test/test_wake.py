@@ -8,7 +8,7 @@ import rospy
 import rospy.rostime
 
 from tb3_common import wake
-from tb3_common.ros.lifecycle import Life
+from tb3_common.ros.lifecycle import Life, SimAlarm
 
 
 def test_the_reader_sees_what_the_node_writes_and_acting_once_it_is_gone(tmp_path):
@@ -92,6 +92,46 @@ def test_a_life_without_a_notice_writes_nothing_and_sleeps_as_before(sim_time):
     assert not sleeper.is_alive()
     with life.waiting_for_data():
         pass
+
+
+class CountedCondition(threading.Condition):
+    def __init__(self):
+        super(CountedCondition, self).__init__()
+        self.notices = 0
+
+    def notify_all(self):
+        self.notices += 1
+        super(CountedCondition, self).notify_all()
+
+
+def test_a_clock_alarm_wakes_a_sleeper_at_its_end_and_when_time_goes_back_not_at_every_tick(sim_time):
+    """rospy would wake it at each /clock tick: nine of ten for nothing in a 10 Hz loop."""
+    from rosgraph_msgs.msg import Clock
+    life = Life()
+    life._alarm = alarm = SimAlarm()
+    alarm.condition = CountedCondition()
+
+    def tick(ns):  # what rospy's /clock subscription does: the time, then the alarm's callback
+        sim_time(ns)
+        alarm.on_clock(Clock(rospy.Time(0, ns)))
+
+    ends = []
+    sleeper = threading.Thread(target=lambda: ends.append(life.sleep_sim(0.1)))
+    sleeper.start()
+    assert _wait_for(lambda: alarm.ends)
+    for ns in range(10010000000, 10100000000, 10000000):  # 9 ticks before its end
+        tick(ns)
+    assert alarm.condition.notices == 0 and sleeper.is_alive()
+    tick(10100000000)
+    sleeper.join(5.0)
+    assert not sleeper.is_alive() and ends == [True] and alarm.condition.notices == 1 and not alarm.ends
+    # A reset: the clock goes back, and a sleeper wakes at once.
+    sleeper = threading.Thread(target=lambda: ends.append(life.sleep_sim(5.0)))
+    sleeper.start()
+    assert _wait_for(lambda: alarm.ends)
+    tick(20000000)
+    sleeper.join(5.0)
+    assert not sleeper.is_alive() and ends == [True, True] and alarm.condition.notices == 2
 
 
 def test_one_notice_for_the_threads_awaiting_only_while_every_thread_awaits():

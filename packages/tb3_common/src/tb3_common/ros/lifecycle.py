@@ -76,6 +76,7 @@ class Life(object):
         self._wakes = {}  # thread id -> sim ns before which it does nothing of its own accord (wake.ACTING: now)
         self._wakes_lock = threading.Lock()
         self._stores = False  # it declared topics it only stores
+        self._alarm = None  # a SimAlarm once follow_clock() made one
 
     def request_stop(self, reason):
         """Safe in a signal handler: sets the flag (and arms the stacks' print, STACKS_AFTER)."""
@@ -95,18 +96,36 @@ class Life(object):
     def sleep_sim(self, seconds):
         """Waits `seconds` of ROS time (sim time under /clock), less if an end is asked for or time
         jumps back; False if an end was asked for. (rospy.sleep and rospy.Rate wait for a clock that
-        stopped, a simulator gone, until rospy itself shuts down: a signal here only sets the flag.)"""
-        condition = rospy.rostime.get_rostime_cond()
+        stopped, a simulator gone, until rospy itself shuts down: a signal here only sets the flag.)
+        After follow_clock() the thread wakes at its end, not at every /clock tick."""
+        alarm = self._alarm
+        condition = rospy.rostime.get_rostime_cond() if alarm is None else alarm.condition
         start = rospy.get_rostime()
         end = start + rospy.Duration(seconds)
+        thread = threading.get_ident()
         with self._waking_at(end.to_nsec()):
-            while not self.stopping:
-                now = rospy.get_rostime()
-                if now >= end or now < start:
-                    return True
-                with condition:
-                    condition.wait(0.1)
+            try:
+                while not self.stopping:
+                    # The time is read and the wait begun under the lock the wake-up takes after the
+                    # clock moved: no tick slips in between.
+                    with condition:
+                        now = rospy.get_rostime()
+                        if now >= end or now < start:
+                            return True
+                        if alarm is not None:
+                            alarm.ends[thread] = end.to_nsec()
+                        condition.wait(0.1)
+            finally:
+                if alarm is not None:
+                    with condition:
+                        alarm.ends.pop(thread, None)
         return False
+
+    def follow_clock(self):
+        """Wake the threads in sleep_sim at their ends only (SimAlarm), from rospy's /clock subscription."""
+        from rosgraph_msgs.msg import Clock
+        self._alarm = SimAlarm()
+        rospy.Subscriber('/clock', Clock, self._alarm.on_clock)
 
     def waiting_for_data(self, except_stored=False):
         """A context in which the calling thread waits for messages only (no timed wake-up); with
@@ -207,12 +226,36 @@ class Life(object):
             time.sleep(PARENT_POLL)
 
 
+class SimAlarm(object):
+    """Wakes the threads that sleep in sim time when the earliest of their ends has come or the time
+    went back, rather than at every /clock tick.
+
+    rospy wakes every thread waiting for ROS time at each /clock message (100 Hz of sim time from the
+    simulator): a loop at 10 or 20 Hz finds nothing to do nine times in ten, each time a thread
+    switch and the interpreter's lock taken, which every other thread of the node then waits for (the
+    SLAM's tf loop, doc/speed.md). on_clock is a second callback on rospy's own /clock subscription:
+    it runs after rospy has taken the new time."""
+
+    def __init__(self):
+        self.condition = threading.Condition()
+        self.ends = {}  # thread id -> sim ns it sleeps until (changed under `condition`)
+        self._last = None  # the last tick's sim ns
+
+    def on_clock(self, message):
+        ns = message.clock.to_nsec()
+        with self.condition:
+            if self.ends and (ns >= min(self.ends.values()) or (self._last is not None and ns < self._last)):
+                self.condition.notify_all()
+            self._last = ns
+
+
 def init_node(name, watch_clock=True, **keywords):
     """rospy.init_node(name, ...) with the ends above wired: the node's Life.
 
     Call from the main thread, as rospy.init_node; handlers installed before it
-    registers, so that no signal finds rospy's own. `watch_clock`: see
-    warn_when_left_on_wall_time (the simulator, which publishes /clock, says False)."""
+    registers, so that no signal finds rospy's own. `watch_clock`: the node
+    follows /clock (warn_when_left_on_wall_time, Life.follow_clock); the
+    simulator, which publishes it, says False."""
     try:
         notice = wake.Notice()
     except OSError as error:  # no shared memory: the simulator waits for this node at every tick
@@ -229,6 +272,8 @@ def init_node(name, watch_clock=True, **keywords):
         threading.Thread(target=life._watch_parent, args=(parent,), name='parent_watch', daemon=True).start()
     if watch_clock:
         warn_when_left_on_wall_time()
+        if not rospy.rostime.is_wallclock():
+            life.follow_clock()
     return life
 
 
