@@ -64,6 +64,20 @@ def shortest_paths(graph, sources, limit=np.inf):
 
 
 @numba.njit(cache=True, nogil=True)
+def _weight(steps, heuristic, width, cell, dx, dy):  # pragma: no cover
+    """The weight of the edge from `cell` to its neighbour (dx, dy) (GridGraph's rule): inf if that
+    cell is blocked, or if the step is diagonal and a cell it passes between is."""
+    target = cell + dy * width + dx
+    if dx == 0 or dy == 0:
+        weight = steps[target]
+    elif math.isinf(steps[cell + dy * width]) or math.isinf(steps[cell + dx]):
+        return math.inf
+    else:
+        weight = steps[target] * SQRT2
+    return max(weight + heuristic[target] - heuristic[cell], 0.0)
+
+
+@numba.njit(cache=True, nogil=True)
 def _search(steps, heuristic, width, connectivity, sources, limit, distances, predecessors):  # pragma: no cover
     """Dijkstra over the grid's edges (GridGraph's weights), filling `distances` and `predecessors`,
     with a binary heap of (distance, cell) entries: one is pushed each time a cell's distance
@@ -105,14 +119,7 @@ def _search(steps, heuristic, width, connectivity, sources, limit, distances, pr
             target = cell + dy * width + dx
             if done[target]:
                 continue
-            if k < 4:
-                weight = steps[target]
-            elif math.isinf(steps[cell + dy * width]) or math.isinf(steps[cell + dx]):
-                continue
-            else:
-                weight = steps[target] * SQRT2
-            weight = weight + heuristic[target] - heuristic[cell]
-            reached = key + max(weight, 0.0)
+            reached = key + _weight(steps, heuristic, width, cell, dx, dy)
             if not reached <= limit or not reached < distances[target]:
                 continue
             distances[target], predecessors[target] = reached, cell
@@ -155,22 +162,20 @@ def neighbours(graph, cell):
 def path_cost(graph, cells):
     """The sum of `graph`'s weights along the path `cells` (flat indices, each a neighbour of the
     one before): inf if a step is no edge of it or is blocked."""
-    cells = np.asarray(cells, dtype=np.int64)
-    if len(cells) < 2:
-        return 0.0
-    width = graph.shape[1]
-    sources, targets = cells[:-1], cells[1:]
-    dx, dy = targets % width - sources % width, targets // width - sources // width
-    diagonal = (dx != 0) & (dy != 0)
-    if (np.any((np.abs(dx) > 1) | (np.abs(dy) > 1) | ((dx == 0) & (dy == 0)))
-            or (graph.connectivity == 4 and diagonal.any())):
-        return np.inf
-    steps, heuristic = graph.steps.ravel(), graph.heuristic.ravel()
-    sides = np.isfinite(steps[sources + dy * width]) & np.isfinite(steps[sources + dx])
-    if np.any(diagonal & ~sides) or not np.all(np.isfinite(steps[targets])):
-        return np.inf
-    weights = np.where(diagonal, steps[targets] * SQRT2, steps[targets]) + heuristic[targets] - heuristic[sources]
-    return float(np.sum(np.maximum(weights, 0.0)))
+    return _path_cost(graph.steps.ravel(), graph.heuristic.ravel(), graph.shape[1], graph.connectivity,
+                      np.asarray(cells, dtype=np.int64).ravel())
+
+
+@numba.njit(cache=True, nogil=True)
+def _path_cost(steps, heuristic, width, connectivity, cells):  # pragma: no cover
+    total = 0.0
+    for i in range(len(cells) - 1):
+        dx = cells[i + 1] % width - cells[i] % width
+        dy = cells[i + 1] // width - cells[i] // width
+        if abs(dx) > 1 or abs(dy) > 1 or (dx == 0 and dy == 0) or (connectivity == 4 and dx != 0 and dy != 0):
+            return math.inf
+        total += _weight(steps, heuristic, width, cells[i], dx, dy)
+    return total
 
 
 def path_to(predecessors, target):

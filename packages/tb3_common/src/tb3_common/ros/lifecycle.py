@@ -102,9 +102,12 @@ class Life(object):
         condition = rospy.rostime.get_rostime_cond() if alarm is None else alarm.condition
         start = rospy.get_rostime()
         end = start + rospy.Duration(seconds)
-        thread = threading.get_ident()
-        with self._waking_at(end.to_nsec()):
+        end_ns, thread = end.to_nsec(), threading.get_ident()
+        with self._waking_at(end_ns):
             try:
+                if alarm is not None:
+                    with condition:
+                        alarm.ends[thread] = end_ns
                 while not self.stopping:
                     # The time is read and the wait begun under the lock the wake-up takes after the
                     # clock moved: no tick slips in between.
@@ -112,8 +115,6 @@ class Life(object):
                         now = rospy.get_rostime()
                         if now >= end or now < start:
                             return True
-                        if alarm is not None:
-                            alarm.ends[thread] = end.to_nsec()
                         condition.wait(0.1)
             finally:
                 if alarm is not None:
