@@ -124,6 +124,27 @@ def test_footprint_cost_is_the_highest_cost_under_its_outline_and_refuses_lethal
     assert costmap.footprint_cost([(0.95, 0.0, 0.0)])[0] == -3
 
 
+def test_footprint_cost_finds_the_cells_footprint_points_and_the_grid_find_on_a_turned_grid_scaled():
+    """The compiled cost places each outline point in the cell Grid.to_cells gives footprint_points',
+    also on a turned grid, with DWA's scaled footprint, and for poses half off the map."""
+    grid = Grid(RESOLUTION, 30, 20, origin=(-0.4, -0.7, 0.6))
+    costs = np.random.default_rng(3).integers(0, 253, grid.shape).astype(np.uint8)
+    costs[4:6, 10:12], costs[14, 3:9] = LETHAL_OBSTACLE, NO_INFORMATION
+    costmap = Costmap(grid, CostmapConfig(track_unknown_space=True), static=np.zeros(grid.shape, dtype=np.int8))
+    costmap.costs = costs
+    rng = np.random.default_rng(8)
+    poses = np.column_stack((rng.uniform(-1.5, 1.5, 4000), rng.uniform(-1.5, 1.5, 4000), rng.uniform(-4, 4, 4000)))
+    for scale in (1.0, 1.3):
+        cells = grid.to_cells(costmap.footprint_points(poses, scale))
+        inside = grid.inside(cells).all(axis=1)
+        under = np.where(grid.inside(cells), costmap.cost_at(costmap.footprint_points(poses, scale)), FREE_SPACE)
+        expected = np.where(~inside, -3.0, np.where(np.any(under == LETHAL_OBSTACLE, axis=1), -1.0, np.where(
+            np.any(under == NO_INFORMATION, axis=1), -2.0, under.max(axis=1))))
+        found = costmap.footprint_cost(poses, scale)
+        assert np.array_equal(found, expected)
+        assert {-3.0, -2.0, -1.0} <= set(found) and np.count_nonzero(found >= 0) > 100
+
+
 # --- publishing -----------------------------------------------------------------------------
 
 def test_occupancy_grid_translation_table():
