@@ -7,6 +7,9 @@ cell it crosses by more than a corner) and the cells are listed once per
 scan, as costmap_2d clears a cell once per scan (gmapping counts a visit
 per beam instead; tb3_navigation.occupancy says why we do not).
 """
+import math
+
+import numba
 import numpy as np
 
 STEP = 0.25  # of a cell, between two samples of a beam
@@ -20,23 +23,34 @@ def crossed_cells(grid, origin, ends, step=STEP):
     if not len(ends):
         return np.zeros(0, dtype=np.intp)
     start = grid.to_cells_float(np.asarray(origin, dtype=float))
-    stops = grid.to_cells_float(ends)
-    span = stops - start
-    lengths = np.hypot(span[:, 0], span[:, 1])
-    samples = max(1, int(np.ceil(lengths.max() / step)))
-    fractions = np.arange(samples) / float(samples)
-    # (n, samples) cells along each segment, each stopping short of its end; x and y
-    # apart, not as (n, samples, 2): the same work on half the memory traffic.
-    ix = np.floor(start[0] + span[:, 0:1] * fractions).astype(np.intp)
-    iy = np.floor(start[1] + span[:, 1:2] * fractions).astype(np.intp)
-    end_x, end_y = np.floor(stops[:, 0:1]).astype(np.intp), np.floor(stops[:, 1:2]).astype(np.intp)
-    keep = ((ix != end_x) | (iy != end_y)) & (ix >= 0) & (ix < grid.width) & (iy >= 0) & (iy < grid.height)
-    if lengths.min() <= 1e-9:
-        keep &= (lengths > 1e-9)[:, None]  # a segment of no length crosses nothing
     # Marking a grid-sized mask lists each cell once, sorted, without np.unique's sort.
-    crossed = np.zeros(grid.width * grid.height, dtype=bool)
-    crossed[iy[keep] * grid.width + ix[keep]] = True
+    crossed = np.zeros(grid.width * grid.height, dtype=np.bool_)
+    _mark_crossed(float(start[0]), float(start[1]), grid.to_cells_float(ends), step, grid.width, grid.height,
+                  crossed)
     return np.flatnonzero(crossed)
+
+
+@numba.njit(cache=True, nogil=True)
+def _mark_crossed(x0, y0, stops, step, width, height, crossed):  # pragma: no cover
+    """Marks in `crossed` the cells of the samples along each segment from (x0, y0) to a row of `stops`
+    (cell units): every segment sampled at the same fractions k / samples of it, as many as the longest
+    needs, so that it steps at most `step`; the end cell and cells off the grid left out. Why compiled:
+    numpy's (beams x samples) arrays took 2 ms a scan, and each of move_base's costmaps clears with
+    every scan (doc/speed.md)."""
+    longest = 0.0
+    for i in range(len(stops)):
+        longest = max(longest, math.hypot(stops[i, 0] - x0, stops[i, 1] - y0))
+    samples = max(1, int(math.ceil(longest / step)))
+    for i in range(len(stops)):
+        span_x, span_y = stops[i, 0] - x0, stops[i, 1] - y0
+        if math.hypot(span_x, span_y) <= 1e-9:
+            continue  # a segment of no length crosses nothing
+        end_x, end_y = math.floor(stops[i, 0]), math.floor(stops[i, 1])
+        for k in range(samples):
+            fraction = k / samples
+            ix, iy = math.floor(x0 + span_x * fraction), math.floor(y0 + span_y * fraction)
+            if (ix != end_x or iy != end_y) and 0 <= ix < width and 0 <= iy < height:
+                crossed[iy * width + ix] = True
 
 
 def end_cells(grid, ends):
