@@ -111,6 +111,16 @@ def straight_plan(length=1.2, yaw=0.0):
     return np.stack((steps * math.cos(yaw), steps * math.sin(yaw), np.full_like(steps, yaw)), axis=-1)
 
 
+def test_oscillation_flags_rule_out_the_velocities_they_name():
+    """base_local_planner's OscillationCostFunction: with left_only set, no sample turning right."""
+    _, controller = open_field()
+    plan = straight_plan(yaw=-0.6)
+    assert controller.compute((0.0, 0.0, 0.0), (0.1, 0.0), plan).w < 0
+    controller._flags['left_only'] = True
+    command = controller.compute((0.0, 0.0, 0.0), (0.1, 0.0), plan)
+    assert command.ok and command.w >= 0
+
+
 def test_follows_a_straight_plan_at_full_speed_within_the_dynamic_window():
     _, controller = open_field()
     command = controller.compute((0.0, 0.0, 0.0), (0.0, 0.0), straight_plan())

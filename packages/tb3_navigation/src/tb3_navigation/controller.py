@@ -291,7 +291,7 @@ class DwaController(object):
         moving = (np.abs(samples[:, 0]) + EPSILON >= config.min_vel_trans) | \
                  (np.abs(samples[:, 1]) + EPSILON >= config.min_vel_theta)
         samples = samples[moving & (np.abs(samples[:, 0]) - EPSILON <= config.max_vel_trans)]
-        samples = samples[[self._allowed(v, w) for v, w in samples]] if self._flags else samples
+        samples = samples[self._allowed(samples[:, 0], samples[:, 1])] if self._flags else samples
         if not len(samples):
             return Command(0.0, 0.0, False, reason='no velocity in the dynamic window')
         far = math.hypot(goal[0] - pose[0], goal[1] - pose[1]) > GOAL_ZONE
@@ -307,9 +307,10 @@ class DwaController(object):
     # --- oscillation flags (base_local_planner's OscillationCostFunction) ------------------
 
     def _allowed(self, v, w):
+        """Where the velocities (arrays) `v`, `w` are not ruled out by the flags set."""
         flags = self._flags
-        return not ((flags.get('forward_only') and v < 0) or (flags.get('backward_only') and v > 0) or
-                    (flags.get('left_only') and w < 0) or (flags.get('right_only') and w > 0))
+        return ~((bool(flags.get('forward_only')) & (v < 0)) | (bool(flags.get('backward_only')) & (v > 0)) |
+                 (bool(flags.get('left_only')) & (w < 0)) | (bool(flags.get('right_only')) & (w > 0)))
 
     def _update_flags(self, pose, v, w):
         flags, config = self._flags, self.config
