@@ -168,7 +168,11 @@ class LoopCloser(object):
     def _match_old(self, index, points, walls):
         """(old scan, pose) of scan `index` matched against the old scans near it, or None: the match
         must agree with the pose (within NEGLIGIBLE) or score CLEARER than it (along a corridor a
-        slide scores the same)."""
+        slide scores the same); and the search's best yields to the match nearest the pose (refined
+        from it) unless it scores CLEARER than that one too. Why: a pose whose heading drifted 2.6
+        degrees scores poorly as it is, so a slide of 36 cm along the house's south hallway, which
+        fixed the heading, passed as clearer than it, and the graph took it (a recorded exploration,
+        doc/speed.md)."""
         c = self.config
         old = self._old_scans_near(index, walls())
         if len(old) < c.loop_match_minimum_chain_size:
@@ -179,6 +183,9 @@ class LoopCloser(object):
             return None
         start, _ = matcher.search(field, points, pose, c.loop_search_linear, c.loop_search_angular, c.lstep, c.astep)
         matched, score = matcher.refine(field, points, start, 2 * c.iterations)
+        near, near_score = matcher.refine(field, points, pose, 2 * c.iterations)
+        if near_score >= score - CLEARER * len(points):
+            matched, score = near, near_score
         if score < c.loop_match_minimum_response_fine * len(points):
             return None
         gain = score - field.score(matcher.place(pose, points))
