@@ -87,9 +87,15 @@ def wait_for_sim(sim, recorder):
 
 def start_script_paused(sim, script, log_dir):
     """With the simulator paused at time 0: the script started, given time to
-    connect (its publisher of /cmd_vel registered, then SETTLE wall seconds),
-    and physics unpaused. The script then starts at the same sim time in every
-    run, whatever the factor and however long python takes to start."""
+    connect (its publisher of /cmd_vel connected to the simulator, then SETTLE
+    wall seconds), and physics unpaused. The script then starts at the same sim
+    time in every run, whatever the factor and however long python takes to
+    start. Not its registration alone: the simulator, niced, may connect later
+    than SETTLE on a loaded machine, and lockstep follows a publisher only once
+    connected, so the script's first ticks would go unwaited for (a run at
+    factor 0 ended 2.6 cm from the factor 1 run's end, 2026-11-30, doc/testing.md)."""
+    import xmlrpc.client
+
     import rosgraph
     import rospy
     from std_srvs.srv import Empty
@@ -111,14 +117,23 @@ def start_script_paused(sim, script, log_dir):
     def has_service(name):
         return any(service == name for service, _ in master.getSystemState()[2])
 
-    def publishes_cmd_vel():
-        return any(topic == '/cmd_vel' and set(nodes) - {'/tb3_sim'}
-                   for topic, nodes in master.getSystemState()[0])
+    def cmd_vel_connected():
+        """Whether a publisher of /cmd_vel but the simulator has a connection to it (its bus info)."""
+        for topic, nodes in master.getSystemState()[0]:
+            for node in set(nodes) - {'/tb3_sim'} if topic == '/cmd_vel' else ():
+                try:
+                    code, _, connections = xmlrpc.client.ServerProxy(master.lookupNode(node)).getBusInfo(
+                        rospy.get_name())
+                except Exception:  # not up yet, or gone (the process check says which)
+                    continue
+                if code == 1 and any(entry[4] == '/cmd_vel' and entry[1] == '/tb3_sim' for entry in connections):
+                    return True
+        return False
 
     wait_until(lambda: has_service('/gazebo/unpause_physics'), 'simulator (its unpause service)')
     process = Process(script[:-3], ['rosrun', 'tb3_sim_nav', script], log_dir)
     try:
-        wait_until(publishes_cmd_vel, 'publisher of /cmd_vel from %s' % script, process)
+        wait_until(cmd_vel_connected, 'connection of the simulator to the /cmd_vel of %s' % script, process)
         settle = time.monotonic() + SETTLE
         wait_until(lambda: time.monotonic() >= settle, 'end of the settling time', process)
         rospy.ServiceProxy('/gazebo/unpause_physics', Empty)()
