@@ -171,8 +171,8 @@ class LoopCloser(object):
         slide scores the same); and the search's best yields to the match nearest the pose (refined
         from it) unless it scores CLEARER than that one too. Why: a pose whose heading drifted 2.6
         degrees scores poorly as it is, so a slide of 36 cm along the house's south hallway, which
-        fixed the heading, passed as clearer than it, and the graph took it (a recorded exploration,
-        doc/speed.md)."""
+        fixed the heading, passed as clearer than it, and the graph took it (seen replaying a recorded
+        exploration, doc/speed.md; test_loop_closure's corridor)."""
         c = self.config
         old = self._old_scans_near(index, walls())
         if len(old) < c.loop_match_minimum_chain_size:

@@ -35,8 +35,8 @@ def _mark_crossed(x0, y0, stops, step, width, height, crossed):  # pragma: no co
     """Marks in `crossed` the cells of the samples along each segment from (x0, y0) to a row of `stops`
     (cell units): every segment sampled at the same fractions k / samples of it, as many as the longest
     needs, so that it steps at most `step`; the end cell and cells off the grid left out. Why compiled:
-    numpy's (beams x samples) arrays took 2 ms a scan, and each of move_base's costmaps clears with
-    every scan (doc/speed.md)."""
+    numpy's (beams x samples) temporaries were most of the clearing, and each of move_base's costmaps
+    clears with every scan (timings in doc/speed.md)."""
     longest = 0.0
     for i in range(len(stops)):
         longest = max(longest, math.hypot(stops[i, 0] - x0, stops[i, 1] - y0))
