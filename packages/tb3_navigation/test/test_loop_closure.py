@@ -5,7 +5,7 @@ import numpy as np
 
 from tb3_common.grid import Grid
 from tb3_common.pose2d import IDENTITY
-from tb3_navigation.loop_closure import LoopCloser, Node
+from tb3_navigation.loop_closure import MATCHED, LoopCloser, Node, closure_information
 from tb3_navigation.scan import Scan
 from tb3_navigation.slam_config import SlamConfig
 
@@ -22,11 +22,8 @@ def corridor_scan(pose, beams=360, range_max=3.5):
     return Scan(-math.pi, 2 * math.pi / beams, ranges, 0.12, range_max)
 
 
-def test_a_pose_whose_heading_drifted_is_turned_back_where_it_is_not_slid_along_the_corridor():
-    """Out along the corridor and back to the start; the pose of the last scan 3 degrees off in heading.
-    The coarse search finds places along the corridor about as good as any (here one 0.4 m on). That
-    match scores clearly better than the turned pose as it is, but no better than the pose refined where
-    it lies: the closure takes the latter (the position kept, the heading turned back)."""
+def corridor_there_and_back():
+    """A LoopCloser that went 5 m out along the corridor and back to the start (search off)."""
     config = SlamConfig()
     loops = LoopCloser(config, Grid(config.delta, 400, 400, (-10.0, -10.0, 0.0)))
     no_walls = np.zeros((400, 400), dtype=bool)
@@ -34,11 +31,42 @@ def test_a_pose_whose_heading_drifted_is_turned_back_where_it_is_not_slid_along_
     for pose in path:
         scan = corridor_scan(pose)
         loops.add(pose, scan.hit_points(IDENTITY), Node(scan, IDENTITY, 3.5, pose), lambda: no_walls, search=False)
+    return loops, path, no_walls
+
+
+def test_a_closure_in_a_corridor_ties_the_pose_across_it_not_along_it():
+    """The scan back at the start sees two walls along x: its closure holds y and the heading as much as
+    a matched step (capped), x barely; seen from an old pose turned by 90 degrees, the same in its frame."""
+    loops, path, no_walls = corridor_there_and_back()
+    points = corridor_scan(path[-1]).hit_points(IDENTITY)
+    old, _, told = loops._match_old(len(path) - 1, points, lambda: no_walls)
+    cap = 1.0 / MATCHED[0] ** 2
+    along, across = closure_information(told, 0.0)[0, 0], closure_information(told, 0.0)[1, 1]
+    assert across > 0.5 * cap and across <= cap * (1 + 1e-9)
+    assert along < 0.01 * across
+    turned = closure_information(told, math.pi / 2)  # the corridor's axis is the old frame's y
+    assert turned[1, 1] < 0.01 * turned[0, 0] and abs(turned[0, 0] - across) < 1e-6 * cap
+    assert np.all(np.linalg.eigvalsh(turned) >= -1e-9) and np.linalg.eigvalsh(turned).max() <= cap * (1 + 1e-9)
+
+
+def test_a_scan_with_no_points_closes_no_loop():
+    """Nothing seen matches anything: once such a scan passed as agreeing with its pose and tied a drifted
+    pose to the old scans as it stood."""
+    loops, path, no_walls = corridor_there_and_back()
+    assert loops._match_old(len(path) - 1, np.zeros((0, 2)), lambda: no_walls) is None
+
+
+def test_a_pose_whose_heading_drifted_is_turned_back_where_it_is_not_slid_along_the_corridor():
+    """Out along the corridor and back to the start; the pose of the last scan 3 degrees off in heading.
+    The coarse search finds places along the corridor about as good as any (here one 0.4 m on). That
+    match scores clearly better than the turned pose as it is, but no better than the pose refined where
+    it lies: the closure takes the latter (the position kept, the heading turned back)."""
+    loops, path, no_walls = corridor_there_and_back()
     truth = path[-1]
     drifted = (truth[0], truth[1], truth[2] + math.radians(3.0))
     loops.graph.poses[-1] = drifted
     points = corridor_scan(truth).hit_points(IDENTITY)
-    old, matched = loops._match_old(len(path) - 1, points, lambda: no_walls)
+    old, matched, _ = loops._match_old(len(path) - 1, points, lambda: no_walls)
     assert old < len(path) - 10
     assert abs(matched[0] - truth[0]) < 0.03 and abs(matched[1] - truth[1]) < 0.03
     assert abs(math.remainder(matched[2] - truth[2], 2 * math.pi)) < math.radians(0.5)
