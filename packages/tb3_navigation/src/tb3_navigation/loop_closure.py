@@ -39,12 +39,6 @@ SNAP = (0.02, 0.01)
 #: A closing match must score this much more per point than the pose as it is: along a corridor, where
 #: a slide scores the same, a match is no evidence.
 CLEARER = 0.05
-#: A closure holds, in each direction, this many times what its scan tells there (matcher.normal_equations:
-#: points' worth), at most as much as MATCHED: a closure along a corridor, or in the yard with one wall in
-#: sight, ties the pose across it, barely along it, and the graph puts the drift along it where it came
-#: from. Held as MATCHED in every direction, such closures (the smallest told 1-4 points' worth of the
-#: position) left their poses 6-27 cm off along the wall (doc/speed.md).
-CLOSURE_WEIGHT = 20.0
 #: m driven between two searches for a loop (a search costs a few tens of ms).
 SEARCH_EVERY = 0.5
 #: A scan is old enough to close a loop with when the robot has driven this many times
@@ -114,9 +108,8 @@ class LoopCloser(object):
         self.graph.add_edge(index - 1, index, front if step is None else step, information(self.config, *followed))
         if closure is None:
             return None
-        old, matched, told = closure
-        self.graph.add_edge(old, index, relative(self.graph.poses[old], matched),
-                            closure_information(told, self.graph.poses[old][2]))
+        old, matched = closure
+        self.graph.add_edge(old, index, relative(self.graph.poses[old], matched), information(self.config))
         if not _differ(np.abs(self.graph.errors()).max(axis=0), (0.0, 0.0, 0.0), NEGLIGIBLE):
             return None
         self.moved = self.graph.optimize()
@@ -173,8 +166,7 @@ class LoopCloser(object):
         return chosen
 
     def _match_old(self, index, points, walls):
-        """(old scan, pose, what its scan tells of it: matcher.normal_equations' hessian) of scan `index`
-        matched against the old scans near it, or None: the match
+        """(old scan, pose) of scan `index` matched against the old scans near it, or None: the match
         must agree with the pose (within NEGLIGIBLE) or score CLEARER than it (along a corridor a
         slide scores the same); and the search's best yields to the match nearest the pose (refined
         from it) unless it scores CLEARER than that one too. Why: a pose whose heading drifted 2.6
@@ -194,13 +186,12 @@ class LoopCloser(object):
         near, near_score = matcher.refine(field, points, pose, 2 * c.iterations)
         if near_score >= score - CLEARER * len(points):
             matched, score = near, near_score
-        if score < c.loop_match_minimum_response_fine * len(points):
-            return None
+        if score < max(c.minimumScore, c.loop_match_minimum_response_fine * len(points)):
+            return None  # as the SLAM's own match: no score from a scan of too few points (none: 0 >= 0.6 * 0)
         gain = score - field.score(matcher.place(pose, points))
         if _differ(matched, pose, NEGLIGIBLE) and gain < CLEARER * len(points):
             return None
-        equations = matcher.normal_equations(field, points, matched)
-        return None if equations is None else (old[0], matched, equations[0])
+        return old[0], matched
 
     def _draw(self, grid, index):
         node = self._nodes[index]
@@ -220,16 +211,6 @@ def information(config, distance=0.0, rotation=0.0):
     translation = config.srr * distance + config.srt * rotation
     turn = config.str * distance + config.stt * rotation
     return np.diag(1.0 / (np.square(MATCHED) + np.square((translation, translation, turn))))
-
-
-def closure_information(told, yaw):
-    """The information matrix of a closure whose scan tells `told` (3, 3: matcher.normal_equations'
-    hessian, map frame) of the pose, seen from an old pose of heading `yaw`: CLOSURE_WEIGHT times what it
-    tells, in the old pose's frame, each direction held at most as MATCHED's position."""
-    cos, sin = math.cos(yaw), math.sin(yaw)
-    turn = np.array(((cos, -sin, 0.0), (sin, cos, 0.0), (0.0, 0.0, 1.0)))  # old frame -> map frame
-    held, directions = np.linalg.eigh(turn.T.dot(CLOSURE_WEIGHT * np.asarray(told)).dot(turn))
-    return (directions * np.clip(held, 0.0, 1.0 / MATCHED[0] ** 2)).dot(directions.T)
 
 
 def _differ(a, b, limits):

@@ -58,18 +58,12 @@ JUMP_SEARCH = 3
 #: m the likelihood field reaches beyond where a scan can land: the robot may drive that far before it
 #: is made anew (at 0.22 m/s, 2 s of driving when the map does not change).
 FIELD_SLACK = 0.5
-#: Points' worth of information a match has in every direction of its position at least: where the
-#: scan tells less (along a hallway, past a doorway: a few door frames and corners against hundreds of
-#: points on two walls), the odometry's prediction makes up the rest. With odom_weight's 20 alone,
-#: those few points slid the pose along hallways the map had drawn a little off, and the map followed:
-#: 20 cm off in 50 s on perfect odometry (doc/speed.md).
+#: Points' worth of information a match has in every direction at least (x, y, and the heading with a
+#: lever of 1 m): where the scan tells less (along a hallway, past a doorway: a few door frames and
+#: corners against hundreds of points on two walls), the odometry's prediction makes up the rest.
+#: With odom_weight's 20 alone, those few points slid the pose along hallways the map had drawn a
+#: little off, and the map followed: 20 cm off in 50 s on perfect odometry (doc/speed.md).
 SURE = 150.0
-#: ... and of its heading (points' worth with a lever of 1 m), apart from the position (a Schur
-#: complement): the directions of one matrix over both mix metres and radians, and where a scan told
-#: the position poorly (an open room, a yard), its heading went to the odometry as well, whose wheels
-#: slip most when turning. Less than SURE let the heading follow a robot held still while its wheels
-#: turned it (test_slam_input); the recorded explorations in doc/speed.md.
-YAW_SURE = 150.0
 #: Share of a scan's points that must land on walls for a pose found at any heading (Slam._relocate): a
 #: scan matched where it belongs scores 0.8 of its points in the house, one 10 degrees off 0.43.
 RELOCATE_SHARE = 0.75
@@ -221,17 +215,10 @@ class Slam(object):
 
     def _prior_information(self, equations):
         """The odometry prior's information for a match whose scan tells `equations` (matcher.normal_equations
-        at the search's pose; None: nothing): odom_weight in every direction, and where the scan tells less
-        than SURE points' worth of the position (along a corridor; the heading left free, a Schur
-        complement) or YAW_SURE of the heading, the rest."""
-        told = np.zeros((3, 3)) if equations is None else equations[0]
-        heading = told[2, 2]
-        position = told[:2, :2] - (np.outer(told[:2, 2], told[2, :2]) / heading if heading > 1e-9 else 0.0)
-        position_told, directions = np.linalg.eigh(position)
-        information = np.zeros((3, 3))
-        information[:2, :2] = (directions * np.maximum(self.config.odom_weight, SURE - position_told)).dot(directions.T)
-        information[2, 2] = max(self.config.odom_weight, YAW_SURE - heading)
-        return information
+        at the search's pose; None: nothing): odom_weight in every direction, and in a direction the scan
+        tells less of than SURE points' worth (along a corridor), the rest."""
+        told, directions = np.linalg.eigh(equations[0] if equations is not None else np.zeros((3, 3)))
+        return (directions * np.maximum(self.config.odom_weight, SURE - told)).dot(directions.T)
 
     def _relocate(self, points, around, score):
         """The pose when the prediction matched nothing, or put less than RELOCATE_SHARE of the points on
