@@ -220,7 +220,7 @@ def test_map_messages_carry_the_grid_and_its_values_both_ways():
     import rospy
     from nav_msgs.msg import OccupancyGrid
 
-    from tb3_common.ros.map_messages import grid_of_message, occupancy_grid
+    from tb3_common.ros.map_messages import MapMessage, grid_of_message, occupancy_grid
     grid = Grid(0.05, 4, 3, (-1.0, 2.0, 0.5))
     values = np.arange(12, dtype=np.int8).reshape(3, 4) - 1
     message = occupancy_grid(grid, values, 'map', rospy.Time(7, 5))
@@ -233,3 +233,8 @@ def test_map_messages_carry_the_grid_and_its_values_both_ways():
     assert back.width == 4 and back.height == 3 and back.origin[:2] == (-1.0, 2.0)
     assert back.origin[2] == pytest.approx(0.5) and back.resolution == pytest.approx(0.05)
     assert np.array_equal(back_values, values) and received.header.frame_id == 'map'
+    # As the nodes' subscribers read it: the data an array straight from the bytes, the same values.
+    received = MapMessage().deserialize(buffer.getvalue())
+    assert isinstance(received.data, np.ndarray) and received._md5sum == OccupancyGrid._md5sum
+    back, back_values, _ = grid_of_message(received)
+    assert back.origin[:2] == (-1.0, 2.0) and np.array_equal(back_values, values)

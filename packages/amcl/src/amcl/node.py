@@ -26,7 +26,6 @@ import numpy as np
 import rospy
 from dynamic_reconfigure.server import Server
 from geometry_msgs.msg import PoseArray, PoseWithCovarianceStamped
-from nav_msgs.msg import OccupancyGrid
 from nav_msgs.srv import GetMap, SetMap, SetMapResponse
 from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty, EmptyResponse
@@ -34,7 +33,7 @@ from std_srvs.srv import Empty, EmptyResponse
 from tb3_common.params import ParameterError
 from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import Frames, namespaced
-from tb3_common.ros.map_messages import grid_of_message
+from tb3_common.ros.map_messages import MapMessage, grid_of_message
 from tb3_common.ros.poses import plane_pose, pose_message
 from tb3_navigation.amcl_config import AmclConfig
 from tb3_navigation.localization import Amcl, covariance_3x3, covariance_6x6
@@ -70,7 +69,7 @@ class AmclNode(object):
         rospy.Service('set_map', SetMap, self._on_set_map)
         rospy.Subscriber('initialpose', PoseWithCovarianceStamped, life.callback(self._on_initial_pose), queue_size=2)
         if self.node_config.use_map_topic:
-            rospy.Subscriber('map', OccupancyGrid, life.callback(self._on_map_topic), queue_size=1)
+            rospy.Subscriber('map', MapMessage, life.callback(self._on_map_topic), queue_size=1)
         else:
             threading.Thread(target=self._request_map, name='static_map', daemon=True).start()
         rospy.Subscriber('scan', LaserScan, life.callback(self._on_scan), queue_size=1)

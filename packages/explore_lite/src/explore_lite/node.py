@@ -26,14 +26,13 @@ import actionlib
 import rospy
 from geometry_msgs.msg import Point
 from move_base_msgs.msg import MoveBaseAction, MoveBaseGoal
-from nav_msgs.msg import OccupancyGrid
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
 from tb3_common.params import Checked, frame_id, non_negative, parameter
 from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import Frames, namespaced
-from tb3_common.ros.map_messages import grid_of_message
+from tb3_common.ros.map_messages import MapMessage, grid_of_message
 from tb3_common.ros.poses import fill_pose
 from tb3_navigation.costmap import CostmapConfig
 from tb3_navigation.exploration import DONE, SEND, WAIT, Explorer
@@ -79,7 +78,7 @@ class ExploreNode(object):
         self._handle = None      # the current goal's handle (kept, or its callbacks stop)
         self.marker_pub = rospy.Publisher('~frontiers', MarkerArray, queue_size=1, latch=True) \
             if self.visualize else None
-        rospy.Subscriber(self.topic, OccupancyGrid, self._on_map, queue_size=1)
+        rospy.Subscriber(self.topic, MapMessage, self._on_map, queue_size=1)
 
     def _on_map(self, message):
         grid, values, _ = grid_of_message(message)

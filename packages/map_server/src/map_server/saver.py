@@ -13,11 +13,10 @@ import threading
 import time
 
 import rospy
-from nav_msgs.msg import OccupancyGrid
 
 from tb3_common import map_files
 from tb3_common.ros import lifecycle
-from tb3_common.ros.map_messages import grid_of_message
+from tb3_common.ros.map_messages import MapMessage, grid_of_message
 
 USAGE = ('Usage: \n'
          '  map_saver -h\n'
@@ -80,7 +79,7 @@ class MapSaver(object):
         self.saved = self.failed = False
         self._lock = threading.Lock()
         rospy.loginfo('Waiting for the map')
-        self.subscriber = rospy.Subscriber('map', OccupancyGrid, self._on_map, queue_size=1)
+        self.subscriber = rospy.Subscriber('map', MapMessage, self._on_map, queue_size=1)
 
     def _on_map(self, message):
         with self._lock:

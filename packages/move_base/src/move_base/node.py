@@ -30,7 +30,7 @@ import tf2_ros
 from actionlib.goal_id_generator import GoalIDGenerator
 from geometry_msgs.msg import PoseStamped, Twist
 from move_base_msgs.msg import MoveBaseAction, MoveBaseActionGoal, MoveBaseFeedback, MoveBaseGoal, MoveBaseResult
-from nav_msgs.msg import OccupancyGrid, Odometry, Path
+from nav_msgs.msg import Odometry, Path
 from nav_msgs.srv import GetPlan, GetPlanResponse
 from sensor_msgs.msg import LaserScan
 from std_srvs.srv import Empty, EmptyResponse
@@ -39,7 +39,7 @@ from tb3_common.params import ParameterError
 from tb3_common.pose2d import compose, inverse, yaw_of_quaternion
 from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import Frames
-from tb3_common.ros.map_messages import grid_of_message
+from tb3_common.ros.map_messages import MapMessage, grid_of_message
 from tb3_common.ros.poses import plane_pose, pose_stamped
 from tb3_navigation.controller import DwaController
 from tb3_navigation.navigator import ABORTED, PREEMPTED, SUCCEEDED, Navigator
@@ -116,7 +116,7 @@ class MoveBaseNode(object):
         self.server.register_preempt_callback(self._on_preempt)
         for io in (self.global_io, self.local_io):
             if io.ros.static_map:
-                rospy.Subscriber(io.ros.map_topic, OccupancyGrid, self._on_map, io, queue_size=1)
+                rospy.Subscriber(io.ros.map_topic, MapMessage, self._on_map, io, queue_size=1)
         for topic in sorted(set(source.topic for io in (self.global_io, self.local_io) for _, source in io.sources)):
             rospy.Subscriber(topic, LaserScan, self._on_scan, topic, queue_size=1)
         rospy.Subscriber('odom', Odometry, self._on_odom, queue_size=1)

@@ -42,7 +42,7 @@ from multirobot_map_merge.config import MapMergeConfig
 from multirobot_map_merge.merge import apply_update, merge
 from tb3_common.ros import lifecycle, params
 from tb3_common.ros.frames import WARN_PERIOD
-from tb3_common.ros.map_messages import grid_of_message, occupancy_grid
+from tb3_common.ros.map_messages import MapMessage, grid_of_message, occupancy_grid
 from tb3_common.ros.poses import plane_pose
 
 try:  # Debian's python3-map-msgs; without it only full maps are followed
@@ -134,7 +134,7 @@ class MapMergeNode(object):
         self.robots[name] = robot
         rospy.loginfo('%s: adding robot [%s]%s; subscribing to %s', NODE, name,
                       ' at (%.3f, %.3f, %.3f)' % init_pose if init_pose else '', topic)
-        robot.subscribers.append(rospy.Subscriber(topic, OccupancyGrid, self.life.callback(
+        robot.subscribers.append(rospy.Subscriber(topic, MapMessage, self.life.callback(
             lambda message: self._on_map(robot, message)), queue_size=1))
         if OccupancyGridUpdate is not None:
             updates = discovery.append(name, self.config.robot_map_updates_topic)

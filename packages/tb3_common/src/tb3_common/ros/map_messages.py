@@ -1,4 +1,5 @@
-"""nav_msgs/OccupancyGrid and MapMetaData from a Grid and its values, and back. Messages only, no rospy.
+"""nav_msgs/OccupancyGrid and MapMetaData from a Grid and its values, and back. Messages only (and rospy's
+numpy_msg for the subscribers' class).
 
 OccupancyGrid's data is row-major from cell (0, 0), the lowest y: the same
 order as the values' [iy, ix] array, so a flat copy is the whole conversion.
@@ -6,9 +7,15 @@ order as the values' [iy, ix] array, so a flat copy is the whole conversion.
 import numpy as np
 from geometry_msgs.msg import Point, Pose, Quaternion
 from nav_msgs.msg import MapMetaData, OccupancyGrid
+from rospy.numpy_msg import numpy_msg
 
 from ..grid import Grid
 from ..pose2d import quaternion_of_yaw, yaw_of_quaternion
+
+#: The class a map's subscriber reads OccupancyGrid as: its data a numpy array made from the message's
+#: bytes, where genpy makes a tuple of python ints, one per cell, that grid_of_message then copies again:
+#: what the SLAM's map cost explore and move_base each time it came (doc/speed.md).
+MapMessage = numpy_msg(OccupancyGrid)
 
 
 def map_metadata(grid, load_time, orientation=None):
