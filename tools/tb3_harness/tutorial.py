@@ -119,15 +119,14 @@ def start_script_paused(sim, script, log_dir):
 
     def cmd_vel_connected():
         """Whether a publisher of /cmd_vel but the simulator has a connection to it (its bus info)."""
-        for topic, nodes in master.getSystemState()[0]:
-            for node in set(nodes) - {'/tb3_sim'} if topic == '/cmd_vel' else ():
-                try:
-                    code, _, connections = xmlrpc.client.ServerProxy(master.lookupNode(node)).getBusInfo(
-                        rospy.get_name())
-                except Exception:  # not up yet, or gone (the process check says which)
-                    continue
-                if code == 1 and any(entry[4] == '/cmd_vel' and entry[1] == '/tb3_sim' for entry in connections):
-                    return True
+        for node in set(dict(master.getSystemState()[0]).get('/cmd_vel', ())) - {'/tb3_sim'}:
+            try:
+                code, _, connections = xmlrpc.client.ServerProxy(master.lookupNode(node)).getBusInfo(
+                    rospy.get_name())
+            except Exception:  # not up yet, or gone (the process check says which)
+                continue
+            if code == 1 and any(entry[4] == '/cmd_vel' and entry[1] == '/tb3_sim' for entry in connections):
+                return True
         return False
 
     wait_until(lambda: has_service('/gazebo/unpause_physics'), 'simulator (its unpause service)')
